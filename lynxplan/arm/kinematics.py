@@ -1,0 +1,126 @@
+"""Closed-form forward kinematics and geometric Jacobian of the 5-DOF arm (SPEC Part 1).
+
+All functions take joint angles in [rad] and return lengths in [m]. The kernels are compiled with
+numba and loop over a batch on one core; the public functions accept one configuration, shape
+(5,), or a batch, shape (N, 5).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from lynxplan.arm.geometry import ArmGeometry
+from lynxplan.exceptions import NonFiniteInputError, ShapeError
+
+_DEFAULT_GEOMETRY = ArmGeometry()
+
+
+@numba.njit(cache=True, nogil=True)
+def fk_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -> None:
+    """Write the tool transforms of the configurations ``q`` (N, 5) into ``out`` (N, 4, 4)."""
+    for k in range(q.shape[0]):
+        s1, c1 = math.sin(q[k, 0]), math.cos(q[k, 0])
+        s2, c2 = math.sin(q[k, 1]), math.cos(q[k, 1])
+        s23, c23 = math.sin(q[k, 1] + q[k, 2]), math.cos(q[k, 1] + q[k, 2])
+        q234 = q[k, 1] + q[k, 2] + q[k, 3]
+        s234, c234 = math.sin(q234), math.cos(q234)
+        s5, c5 = math.sin(q[k, 4]), math.cos(q[k, 4])
+        r = d5 * s234 + a3 * c23 + a2 * c2
+        # Frame-4 axes x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0); n = c5 x4 + s5 y4,
+        # o = -s5 x4 + c5 y4, a = z4 = (c1 s234, s1 s234, -c234)  (SPEC Part 1, closed form).
+        t = out[k]
+        t[0, 0] = c5 * c1 * c234 + s5 * s1
+        t[1, 0] = c5 * s1 * c234 - s5 * c1
+        t[2, 0] = c5 * s234
+        t[0, 1] = -s5 * c1 * c234 + c5 * s1
+        t[1, 1] = -s5 * s1 * c234 - c5 * c1
+        t[2, 1] = -s5 * s234
+        t[0, 2] = c1 * s234
+        t[1, 2] = s1 * s234
+        t[2, 2] = -c234
+        t[0, 3] = c1 * r
+        t[1, 3] = s1 * r
+        t[2, 3] = a3 * s23 + a2 * s2 - d5 * c234
+        t[3, 0] = 0.0
+        t[3, 1] = 0.0
+        t[3, 2] = 0.0
+        t[3, 3] = 1.0
+
+
+@numba.njit(cache=True, nogil=True)
+def jacobian_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -> None:
+    """Write the geometric tool Jacobians (LOCAL_WORLD_ALIGNED) of ``q`` (N, 5) into ``out``.
+
+    ``out`` has shape (N, 6, 5): rows 0-2 map joint rates to the tool point's linear velocity in
+    [m/s], rows 3-5 to the angular velocity in [rad/s], both in base-frame axes.
+    """
+    for k in range(q.shape[0]):
+        s1, c1 = math.sin(q[k, 0]), math.cos(q[k, 0])
+        s2, c2 = math.sin(q[k, 1]), math.cos(q[k, 1])
+        s23, c23 = math.sin(q[k, 1] + q[k, 2]), math.cos(q[k, 1] + q[k, 2])
+        q234 = q[k, 1] + q[k, 2] + q[k, 3]
+        s234, c234 = math.sin(q234), math.cos(q234)
+        # Column i: z_{i-1} x (p - o_{i-1}) and z_{i-1}. z0 = (0,0,1); z1 = z2 = z3 = (s1,-c1,0);
+        # z4 = approach axis. Distances in the arm plane: radial r_i and height h_i of p - o_i.
+        r_tool = d5 * s234 + a3 * c23 + a2 * c2
+        h_tool = a3 * s23 + a2 * s2 - d5 * c234
+        r_elbow, h_elbow = r_tool - a2 * c2, h_tool - a2 * s2
+        r_wrist, h_wrist = d5 * s234, -d5 * c234
+        j = out[k]
+        j[0, 0] = -s1 * r_tool
+        j[1, 0] = c1 * r_tool
+        j[2, 0] = 0.0
+        # (s1, -c1, 0) x (c1 r, s1 r, h) = (-c1 h, -s1 h, r)
+        j[0, 1], j[1, 1], j[2, 1] = -c1 * h_tool, -s1 * h_tool, r_tool
+        j[0, 2], j[1, 2], j[2, 2] = -c1 * h_elbow, -s1 * h_elbow, r_elbow
+        j[0, 3], j[1, 3], j[2, 3] = -c1 * h_wrist, -s1 * h_wrist, r_wrist
+        j[0, 4], j[1, 4], j[2, 4] = 0.0, 0.0, 0.0
+        j[3, 0], j[4, 0], j[5, 0] = 0.0, 0.0, 1.0
+        for col in range(1, 4):
+            j[3, col], j[4, col], j[5, col] = s1, -c1, 0.0
+        j[3, 4], j[4, 4], j[5, 4] = c1 * s234, s1 * s234, -c234
+
+
+def as_configurations(q: np.ndarray | list[float] | tuple[float, ...], name: str = "q") -> np.ndarray:
+    """Validate joint angles: shape (5,) or (N, 5), finite. Returns a float (N, 5) array."""
+    array = np.asarray(q, dtype=float)
+    if array.ndim not in (1, 2) or array.shape[-1] != 5:
+        raise ShapeError(name, "(5,) or (N, 5)", array.shape)
+    if not np.isfinite(array).all():
+        raise NonFiniteInputError(name)
+    return np.ascontiguousarray(array.reshape(-1, 5))
+
+
+def forward_kinematics(q: np.ndarray, geometry: ArmGeometry = _DEFAULT_GEOMETRY) -> np.ndarray:
+    """Tool (pen tip) pose in the base frame.
+
+    Args:
+        q: Joint angles, shape (5,) or (N, 5), in [rad].
+        geometry: Arm dimensions.
+
+    Returns:
+        Homogeneous transforms, shape (4, 4) or (N, 4, 4), translations in [m].
+    """
+    batch = as_configurations(q)
+    out = np.empty((batch.shape[0], 4, 4))
+    fk_kernel(batch, geometry.a2, geometry.a3, geometry.d5, out)
+    return out[0] if np.ndim(q) == 1 else out
+
+
+def tool_jacobian(q: np.ndarray, geometry: ArmGeometry = _DEFAULT_GEOMETRY) -> np.ndarray:
+    """Geometric Jacobian of the tool frame in base-frame axes (Pinocchio LOCAL_WORLD_ALIGNED).
+
+    Args:
+        q: Joint angles, shape (5,) or (N, 5), in [rad].
+        geometry: Arm dimensions.
+
+    Returns:
+        Shape (6, 5) or (N, 6, 5): rows (vx, vy, vz) in [m/rad], rows (wx, wy, wz) unitless.
+    """
+    batch = as_configurations(q)
+    out = np.empty((batch.shape[0], 6, 5))
+    jacobian_kernel(batch, geometry.a2, geometry.a3, geometry.d5, out)
+    return out[0] if np.ndim(q) == 1 else out

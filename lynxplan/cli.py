@@ -1,0 +1,58 @@
+"""Command-line entry point: argument parsing and error display only.
+
+Each sub-command lives in a module of :mod:`lynxplan.commands` that exposes
+``register(subparsers)``; the handler it sets returns the process exit code.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Sequence
+
+from lynxplan import __version__
+from lynxplan.exceptions import LynxplanError
+
+COMMAND_MODULES = (
+    "lynxplan.commands.run",
+    "lynxplan.commands.bench",
+)
+
+
+class _Parser(argparse.ArgumentParser):
+    """ArgumentParser whose usage errors are one line and exit code 2."""
+
+    def error(self, message: str) -> None:  # type: ignore[override]
+        sys.stderr.write(f"{self.prog}: error: {message}\n")
+        raise SystemExit(2)
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The full ``lynxplan`` parser with every sub-command registered."""
+    parser = _Parser(prog="lynxplan", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser.add_argument("--version", action="version", version=f"lynxplan {__version__}")
+    subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
+    subparsers.required = True
+    for name in COMMAND_MODULES:
+        importlib.import_module(name).register(subparsers)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the CLI; returns the exit code (0 ok, 1 expectation failed, 2 bad input)."""
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    try:
+        code: int = args.handler(args)
+    except LynxplanError as exc:
+        sys.stderr.write(f"lynxplan: error: {exc}\n")
+        return 2
+    except KeyboardInterrupt:
+        sys.stderr.write("lynxplan: interrupted\n")
+        return 130
+    return code
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

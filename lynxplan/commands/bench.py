@@ -1,0 +1,34 @@
+"""``lynxplan bench``: print the performance figures of every section."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from lynxplan.bench import SECTIONS, run_sections
+from lynxplan.commands._output import print_json
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``bench`` sub-command."""
+    parser = subparsers.add_parser("bench", help="measure performance figures side by side")
+    parser.add_argument(
+        "--section", action="append", choices=sorted(SECTIONS), help="run only these sections"
+    )
+    parser.add_argument("--quick", action="store_true", help="fewer repeats (smoke test)")
+    parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    """Run the benchmark and print the figures."""
+    figures = run_sections(args.section, quick=args.quick)
+    if args.json:
+        print_json({"figures": [f._asdict() for f in figures]})
+        return 0
+    width = max(len(f.name) for f in figures) if figures else 10
+    for f in figures:
+        verdict = "" if f.met is None else ("  ok" if f.met else "  MISSED")
+        target = f"  (target {f.target})" if f.target else ""
+        print(f"[{f.section}] {f.name:<{width}}  {f.value:>14,.4g} {f.unit}{target}{verdict}")
+    return 0

@@ -1,0 +1,29 @@
+"""``lynxplan run SCENARIO.yaml``: run a scenario file and write its outputs."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from lynxplan.runner import run_scenario
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``run`` sub-command."""
+    parser = subparsers.add_parser("run", help="run a scenario YAML file")
+    parser.add_argument("scenario", help="scenario YAML file")
+    parser.add_argument("--out", default="out", help="output folder (default: ./out)")
+    parser.add_argument("--quick", action="store_true", help="skip plots and HTML")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    """Run the scenario; exit 0 when every expectation holds, 1 otherwise."""
+    outcome = run_scenario(args.scenario, args.out, quick=args.quick)
+    print(outcome.summary)
+    if not outcome.ok:
+        print("failed expectations:")
+        for failure in outcome.failed_expectations:
+            print(f"  - {failure}")
+        return 1
+    return 0
