@@ -19,3 +19,25 @@ STRICT_ORIENTATION_TOLERANCE = 1e-6
 #: A wrist centre up to this far outside the reachable annulus is pulled onto it, in [m]
 #: (poses typed from a 4-decimal inch printout are off by ~1e-6 m); further is out of reach.
 REACH_TOLERANCE = 1e-6
+
+#: Stationary (zero-length) segments chosen by auto-timing last this long, in [s].
+MIN_SEGMENT_DURATION = 1e-3
+
+#: Uniform grid of the path parameter s (0..1) on which a straight line's joint path is solved
+#: once: its finite differences give dq/ds and d2q/ds2 (auto-timing, sampled rates, toppra).
+PATH_GRID_POINTS = 401
+
+#: Sampled velocities/accelerations may exceed a limit by this relative amount before it counts
+#: as a violation (floating-point noise only; toppra's real overshoots are larger and reported).
+LIMIT_CHECK_RELATIVE_TOLERANCE = 1e-6
+
+#: Parallel robot: an assembly mode is accepted when the IK of the pose reproduces the given
+#: actuated angles to this, in [rad].
+PARALLEL_FK_VERIFY_TOLERANCE = 1e-7
+
+#: Parallel robot: a root ``z`` of the closure polynomial is taken as a real orientation when
+#: ``| |z| - 1 |`` is below this (double roots at Type II singularities split by ~sqrt(eps)).
+PARALLEL_FK_UNIT_CIRCLE_TOLERANCE = 1e-5
+
+#: Parallel robot: two assembly modes closer than this (in [m] and [rad]) are the same one.
+PARALLEL_FK_DUPLICATE_TOLERANCE = 1e-7

@@ -130,3 +130,100 @@ class ScenarioError(LynxplanError):
         self.reason = reason
         where = f"{file}, {location}" if location else file
         super().__init__(f"scenario {where}: {reason}")
+
+
+class TimingError(InputError):
+    """An LSPB time law is impossible: durations not positive, or blends that would overlap.
+
+    Attributes:
+        tt: Total segment time, in [s].
+        ta: Blend time, in [s].
+    """
+
+    def __init__(self, tt: float, ta: float, reason: str) -> None:
+        self.tt = tt
+        self.ta = ta
+        super().__init__(f"invalid LSPB timing tt = {tt:.6g} s, ta = {ta:.6g} s: {reason}")
+
+
+class PathNotFollowableError(KinematicsError):
+    """A Cartesian path leaves the arm's reach: some sample has no IK solution.
+
+    Attributes:
+        s: Path parameter in [0, 1] of the first failing sample.
+        reach_miss: By how much that sample misses the reach, in [m].
+    """
+
+    def __init__(self, s: float, reach_miss: float, what: str = "straight line") -> None:
+        self.s = s
+        self.reach_miss = reach_miss
+        super().__init__(
+            f"{what} leaves the arm's reach at s = {s:.4f} (missed by {reach_miss * 1000:.4g} mm)"
+        )
+
+
+class ModelError(LynxplanError):
+    """A robot model (URDF) cannot be loaded or does not have the expected structure."""
+
+
+class LegUnreachableError(KinematicsError):
+    """A leg of the 3-RRR parallel robot cannot reach its platform joint.
+
+    Attributes:
+        leg: Name of the leg (``"A"``, ``"B"`` or ``"C"``).
+        distance: Base-joint-to-platform-joint distance the pose needs, in [m].
+        min_distance: Smallest distance the leg spans ``|S - L|``, in [m].
+        max_distance: Largest distance the leg spans ``S + L``, in [m].
+    """
+
+    def __init__(self, leg: str, distance: float, min_distance: float, max_distance: float) -> None:
+        self.leg = leg
+        self.distance = distance
+        self.min_distance = min_distance
+        self.max_distance = max_distance
+        super().__init__(
+            f"parallel robot: {leg_unreachable_reason(leg, distance, min_distance, max_distance)}"
+        )
+
+
+def leg_unreachable_reason(
+    leg: str, distance: float, min_distance: float, max_distance: float
+) -> str:
+    """One-line reason why leg ``leg`` cannot span ``distance`` (lengths in [m], printed in mm)."""
+    return (
+        f"leg {leg} cannot reach its platform joint: it needs a base-to-platform-joint distance of "
+        f"{distance * 1e3:.4f} mm, outside the range [{min_distance * 1e3:.4f}, "
+        f"{max_distance * 1e3:.4f}] mm it spans"
+    )
+
+
+class DegenerateForwardKinematicsError(KinematicsError):
+    """Forward kinematics of the 3-RRR has a continuum of solutions (architecture singularity).
+
+    Attributes:
+        theta: The actuated angles, shape (3,), in [rad].
+    """
+
+    def __init__(self, theta: tuple[float, float, float]) -> None:
+        self.theta = theta
+        degrees = ", ".join(f"{t * 57.29577951308232:.4f}" for t in theta)
+        super().__init__(
+            f"parallel robot: the actuated angles ({degrees}) deg leave the platform free to move "
+            "(the closure polynomial vanishes identically); forward kinematics is not finite"
+        )
+
+
+class NoAssemblyModeError(KinematicsError):
+    """The actuated angles of the 3-RRR admit no real assembly mode.
+
+    Attributes:
+        theta: The actuated angles, shape (3,), in [rad].
+    """
+
+    def __init__(self, theta: tuple[float, float, float]) -> None:
+        self.theta = theta
+        degrees = ", ".join(f"{t * 57.29577951308232:.4f}" for t in theta)
+        super().__init__(
+            f"parallel robot: the actuated angles ({degrees}) deg admit no assembly mode "
+            "(the distal links cannot all meet the platform)"
+        )
