@@ -84,7 +84,9 @@ def jacobian_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndar
         j[3, 4], j[4, 4], j[5, 4] = c1 * s234, s1 * s234, -c234
 
 
-def as_configurations(q: np.ndarray | list[float] | tuple[float, ...], name: str = "q") -> np.ndarray:
+def as_configurations(
+    q: np.ndarray | list[float] | tuple[float, ...], name: str = "q"
+) -> np.ndarray:
     """Validate joint angles: shape (5,) or (N, 5), finite. Returns a float (N, 5) array."""
     array = np.asarray(q, dtype=float)
     if array.ndim not in (1, 2) or array.shape[-1] != 5:

@@ -1,0 +1,333 @@
+"""The 5-DOF arm as a Pinocchio model built from its URDF, with closed-form kinematics and IK.
+
+:func:`load_arm` returns the default AL5-class arm. The URDF's joint placements are checked
+against the DH structure of SPEC Part 1 and its lengths (a2, a3, d5) are read from it, so an arm
+of the same structure with other dimensions works through the same closed forms.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from functools import cached_property
+from importlib import resources
+from pathlib import Path
+from typing import Any, Literal, NamedTuple
+
+import numpy as np
+
+from lynxplan.arm import ik as _ik
+from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
+from lynxplan.arm.kinematics import as_configurations, forward_kinematics, tool_jacobian
+from lynxplan.constants import (
+    LIMIT_SNAP_TOLERANCE,
+    RIGIDITY_REPAIR_TOLERANCE,
+    STRICT_ORIENTATION_TOLERANCE,
+)
+from lynxplan.exceptions import (
+    ModelError,
+    NonFiniteInputError,
+    NoSolutionWithinLimitsError,
+    NotRigidTransformError,
+    OrientationNotReachableError,
+    ShapeError,
+    UnreachablePoseError,
+)
+
+DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
+#: Tolerance on the URDF's DH structure (rotations, zero offsets), unitless / [m].
+_STRUCTURE_TOLERANCE = 1e-9
+_ZEROS = np.zeros(5)
+_ZEROS.setflags(write=False)
+
+
+def default_urdf_path() -> Path:
+    """Path of the shipped AL5 URDF (package data when installed, ``urdf/`` in a checkout)."""
+    packaged = resources.files("lynxplan") / "_data" / "urdf" / DEFAULT_URDF_NAME
+    if packaged.is_file():
+        return Path(str(packaged))
+    return Path(__file__).resolve().parents[2] / "urdf" / DEFAULT_URDF_NAME
+
+
+class IkSolution(NamedTuple):
+    """One IK branch, checked by forward kinematics.
+
+    Attributes:
+        q: Joint angles, shape (5,), in [rad] (read-only).
+        branch: Branch name, e.g. ``"front/elbow-up"``.
+        within_limits: Whether q is within the joint limits (after snapping).
+        position_error: ``|p_fk(q) - p_target|``, in [m].
+        orientation_error: Angle between the FK rotation and the target, in [rad].
+    """
+
+    q: np.ndarray
+    branch: str
+    within_limits: bool
+    position_error: float
+    orientation_error: float
+
+
+@dataclass(frozen=True)
+class IkResult:
+    """IK of one pose.
+
+    Attributes:
+        solutions: Every branch (four), in :data:`lynxplan.arm.ik.BRANCH_NAMES` order.
+        selected: Index of the chosen solution, or None if none is within limits.
+        orientation_residual: Angle between target and nearest reachable orientation, [rad].
+    """
+
+    solutions: tuple[IkSolution, ...]
+    selected: int | None
+    orientation_residual: float
+
+    @property
+    def q(self) -> np.ndarray:
+        """The selected solution, shape (5,), in [rad].
+
+        Raises:
+            NoSolutionWithinLimitsError: if no branch is within the joint limits.
+        """
+        if self.selected is None:
+            raise NoSolutionWithinLimitsError(
+                "IK: no branch is within the joint limits: "
+                + "; ".join(
+                    f"{s.branch} {np.degrees(s.q).round(3).tolist()} deg" for s in self.solutions
+                )
+            )
+        return self.solutions[self.selected].q
+
+
+Selection = Literal["nearest", "report"]
+
+
+class Arm:
+    """The 5-DOF arm: Pinocchio model + closed-form kinematics + analytic IK.
+
+    Attributes:
+        urdf_path: The URDF the model was built from.
+        model: Pinocchio kinematic model (5 revolute joints).
+        geometry: DH lengths read from the URDF.
+        limits: Position and velocity limits read from the URDF.
+        tool_frame_id: Pinocchio frame id of the tool (pen tip, DH frame 5).
+    """
+
+    def __init__(self, urdf_path: str | Path | None = None) -> None:
+        import pinocchio as pin
+
+        self.urdf_path = Path(urdf_path) if urdf_path is not None else default_urdf_path()
+        if not self.urdf_path.is_file():
+            raise ModelError(f"URDF file not found: {self.urdf_path}")
+        try:
+            self.model = pin.buildModelFromUrdf(str(self.urdf_path))
+        except (RuntimeError, ValueError) as exc:
+            raise ModelError(f"cannot load URDF {self.urdf_path}: {exc}") from exc
+        self.data = self.model.createData()
+        self.geometry = _read_geometry(self.model)
+        self.limits = _read_limits(self.model)
+        self.tool_frame_id = self.model.getFrameId(TOOL_FRAME)
+        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance, limits.
+        g = self.geometry
+        self._ik_params = np.concatenate(
+            ([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE], self.limits.lower, self.limits.upper)
+        )
+        self._ik_params.setflags(write=False)
+
+    # -- geometry models (collision and visual), built on first use ------------------------------
+    @cached_property
+    def collision_model(self) -> Any:
+        """Pinocchio GeometryModel of the URDF's collision elements."""
+        import pinocchio as pin
+
+        return pin.buildGeomFromUrdf(self.model, str(self.urdf_path), pin.GeometryType.COLLISION)
+
+    @cached_property
+    def visual_model(self) -> Any:
+        """Pinocchio GeometryModel of the URDF's visual elements."""
+        import pinocchio as pin
+
+        return pin.buildGeomFromUrdf(self.model, str(self.urdf_path), pin.GeometryType.VISUAL)
+
+    # -- kinematics -------------------------------------------------------------------------------
+    def fk(self, q: np.ndarray) -> np.ndarray:
+        """Tool pose (closed form). q: shape (5,) or (N, 5) in [rad] -> (4, 4) or (N, 4, 4), [m]."""
+        return forward_kinematics(q, self.geometry)
+
+    def jacobian(self, q: np.ndarray) -> np.ndarray:
+        """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5)."""
+        return tool_jacobian(q, self.geometry)
+
+    def frame_placement(self, q: np.ndarray, frame: str = TOOL_FRAME) -> np.ndarray:
+        """Pose of a URDF frame from Pinocchio. q: shape (5,) in [rad] -> (4, 4) in [m].
+
+        Frames: ``"tool"``, ``"dh_frame_1"`` ... ``"dh_frame_4"``, and every URDF link/joint.
+        """
+        import pinocchio as pin
+
+        config = as_configurations(q)[0]
+        frame_id = self._frame_id(frame)
+        pin.forwardKinematics(self.model, self.data, config)
+        return np.array(pin.updateFramePlacement(self.model, self.data, frame_id).homogeneous)
+
+    def frame_jacobian(self, q: np.ndarray, frame: str = TOOL_FRAME) -> np.ndarray:
+        """Pinocchio frame Jacobian, LOCAL_WORLD_ALIGNED. q: (5,) in [rad] -> (6, 5)."""
+        import pinocchio as pin
+
+        config = as_configurations(q)[0]
+        return np.array(
+            pin.computeFrameJacobian(
+                self.model,
+                self.data,
+                config,
+                self._frame_id(frame),
+                pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
+            )
+        )
+
+    def _frame_id(self, frame: str) -> int:
+        if not self.model.existFrame(frame):
+            names = ", ".join(f.name for f in self.model.frames if f.name != "universe")
+            raise ModelError(f"unknown frame {frame!r}; frames: {names}")
+        return int(self.model.getFrameId(frame))
+
+    # -- inverse kinematics -----------------------------------------------------------------------
+    def ik_batch(
+        self,
+        T: np.ndarray,
+        *,
+        q_reference: np.ndarray | None = None,
+        approach_only: bool = False,
+        limit_tolerance: float = LIMIT_SNAP_TOLERANCE,
+    ) -> _ik.IkBatch:
+        """All-branch IK of many poses; see :func:`lynxplan.arm.ik.solve_ik_batch`."""
+        return _ik.solve_ik_batch(
+            T,
+            geometry=self.geometry,
+            limits=self.limits,
+            q_reference=q_reference,
+            approach_only=approach_only,
+            limit_tolerance=limit_tolerance,
+        )
+
+    def ik(
+        self,
+        T: np.ndarray,
+        *,
+        q_reference: np.ndarray | None = None,
+        select: Selection = "nearest",
+        strict: bool = False,
+        orientation_tolerance: float = STRICT_ORIENTATION_TOLERANCE,
+        approach_only: bool = False,
+        limit_tolerance: float = LIMIT_SNAP_TOLERANCE,
+    ) -> IkResult:
+        """IK of one pose: every branch, checked by FK, one selected.
+
+        Args:
+            T: Target tool pose, shape (4, 4), translation in [m].
+            q_reference: Shape (5,), in [rad]: the configuration to stay near (``"nearest"``);
+                also q1 on the base axis and q5 for ``approach_only``. Default: zeros.
+            select: ``"nearest"`` (within limits, nearest to ``q_reference``) or ``"report"``
+                (the report's rule: the first within-limit branch with q2 >= 0 and q3 <= 0).
+            strict: Raise if the orientation cannot be reached within ``orientation_tolerance``.
+            orientation_tolerance: Accepted orientation residual in strict mode, in [rad].
+            approach_only: 5-D target: only column 2 (the approach axis) of the rotation counts.
+            limit_tolerance: Angles this far outside a limit, in [rad], are snapped onto it.
+
+        Raises:
+            ShapeError, NonFiniteInputError, NotRigidTransformError: bad input.
+            UnreachablePoseError: the wrist centre is out of reach (carries the distance).
+            OrientationNotReachableError: strict mode and a residual above the tolerance.
+        """
+        pose = np.asarray(T, dtype=float)
+        if pose.shape != (4, 4):
+            raise ShapeError("T", "(4, 4)", pose.shape)
+        if select not in ("nearest", "report"):
+            raise ValueError(f"select must be 'nearest' or 'report'. Got: {select!r}")
+        if q_reference is None:
+            reference = _ZEROS
+        else:
+            reference = np.asarray(q_reference, dtype=float)
+            if reference.shape != (5,):
+                raise ShapeError("q_reference", "(5,)", reference.shape)
+            if not np.isfinite(reference).all():
+                raise NonFiniteInputError("q_reference")
+        rows, scalars = np.empty((4, 8)), np.empty(5)
+        flags = (1 if approach_only else 0) | (2 if select == "report" else 0)
+        params = self._ik_params
+        if limit_tolerance != LIMIT_SNAP_TOLERANCE:
+            params = params.copy()
+            params[3] = limit_tolerance
+        _ik.ik_single_kernel(pose, reference, params, flags, rows, scalars)
+        residual, status, miss, deviation, selected = scalars.tolist()
+        _raise_for_status(int(status), miss, deviation)
+        if strict and residual > orientation_tolerance:
+            raise OrientationNotReachableError(residual, orientation_tolerance)
+        q = rows[:, :5]
+        q.setflags(write=False)
+        values = rows[:, 5:].tolist()
+        names = _ik.BRANCH_NAMES
+        solutions = (
+            IkSolution(q[0], names[0], values[0][0] > 0.5, values[0][1], values[0][2]),
+            IkSolution(q[1], names[1], values[1][0] > 0.5, values[1][1], values[1][2]),
+            IkSolution(q[2], names[2], values[2][0] > 0.5, values[2][1], values[2][2]),
+            IkSolution(q[3], names[3], values[3][0] > 0.5, values[3][1], values[3][2]),
+        )
+        return IkResult(solutions, None if selected < 0 else int(selected), residual)
+
+
+def _raise_for_status(status: int, miss: float, deviation: float) -> None:
+    if status == _ik.IkStatus.NON_FINITE:
+        raise NonFiniteInputError("T")
+    if status == _ik.IkStatus.NOT_RIGID:
+        raise NotRigidTransformError(deviation, RIGIDITY_REPAIR_TOLERANCE)
+    if status == _ik.IkStatus.OUT_OF_REACH:
+        raise UnreachablePoseError(miss)
+
+
+def _read_limits(model: Any) -> JointLimits:
+    position = np.column_stack((model.lowerPositionLimit, model.upperPositionLimit))
+    velocity = np.array(model.velocityLimit, dtype=float)
+    position.setflags(write=False)
+    velocity.setflags(write=False)
+    return JointLimits(position=position, velocity=velocity)
+
+
+def _read_geometry(model: Any) -> ArmGeometry:
+    """DH lengths from the joint placements; ModelError if the structure is not the AL5's."""
+    names = tuple(model.names)[1:]
+    if names != JOINT_NAMES or model.nq != 5:
+        raise ModelError(f"expected revolute joints {JOINT_NAMES}; the URDF has {names}")
+    rx90 = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
+    placements = [model.jointPlacements[i] for i in range(1, 6)]
+    expected_rotations = (np.eye(3), rx90, np.eye(3), np.eye(3), rx90)
+    for name, placement, rotation in zip(JOINT_NAMES, placements, expected_rotations, strict=True):
+        if not np.allclose(placement.rotation, rotation, atol=_STRUCTURE_TOLERANCE):
+            raise ModelError(f"joint {name}: placement rotation is not the DH model's")
+    a2, a3 = placements[2].translation[0], placements[3].translation[0]
+    tool = model.frames[model.getFrameId(TOOL_FRAME)].placement
+    offsets = np.concatenate(
+        [placements[i].translation for i in (0, 1, 4)]
+        + [placements[2].translation[1:], placements[3].translation[1:], tool.translation[:2]]
+    )
+    if not np.allclose(offsets, 0.0, atol=_STRUCTURE_TOLERANCE) or min(a2, a3) <= 0:
+        raise ModelError("joint placements do not follow the DH model of SPEC Part 1")
+    for frame in (*DH_FRAMES, TOOL_FRAME):
+        if not model.existFrame(frame):
+            raise ModelError(f"the URDF has no frame {frame!r}")
+    d5 = tool.translation[2]
+    if not math.isfinite(d5) or d5 <= 0:
+        raise ModelError("the tool frame must lie ahead of the wrist along the approach axis")
+    return ArmGeometry(a2=float(a2), a3=float(a3), d5=float(d5))
+
+
+_DEFAULT_ARM: Arm | None = None
+
+
+def load_arm(urdf_path: str | Path | None = None) -> Arm:
+    """The arm built from ``urdf_path`` (default: the shipped AL5 URDF, loaded once and shared)."""
+    global _DEFAULT_ARM
+    if urdf_path is not None:
+        return Arm(urdf_path)
+    if _DEFAULT_ARM is None:
+        _DEFAULT_ARM = Arm()
+    return _DEFAULT_ARM
