@@ -227,3 +227,43 @@ class NoAssemblyModeError(KinematicsError):
             f"parallel robot: the actuated angles ({degrees}) deg admit no assembly mode "
             "(the distal links cannot all meet the platform)"
         )
+
+
+class RetimingError(LynxplanError):
+    """A time-parameterisation library (ruckig, toppra) found no trajectory.
+
+    Attributes:
+        method: ``"ruckig"`` or ``"toppra"``.
+        reason: What the library reported.
+    """
+
+    def __init__(self, method: str, reason: str) -> None:
+        self.method = method
+        self.reason = reason
+        super().__init__(f"{method} found no trajectory: {reason}")
+
+
+class InvalidObstacleError(InputError):
+    """An obstacle has a non-positive size or an improper rotation.
+
+    Attributes:
+        obstacle: Name of the obstacle.
+        reason: What is wrong.
+    """
+
+    def __init__(self, obstacle: str, reason: str) -> None:
+        self.obstacle = obstacle
+        self.reason = reason
+        super().__init__(f"obstacle {obstacle!r}: {reason}")
+
+
+class CollisionModelError(LynxplanError):
+    """The robot's collision geometry has a shape or joint the collision checker cannot handle.
+
+    Attributes:
+        geometry: Name of the offending geometry object or joint.
+    """
+
+    def __init__(self, geometry: str, reason: str) -> None:
+        self.geometry = geometry
+        super().__init__(f"collision model, {geometry}: {reason}")

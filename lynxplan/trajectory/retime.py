@@ -1,0 +1,285 @@
+"""Side-by-side time-parameterisations of the same segments (SPEC Part 2, comparisons).
+
+Methods, per segment:
+
+- ``lspb``: the segment's own LSPB timing (the report's tt = 2 s, ta = 0.5 s in the OK task);
+- ``lspb_auto``: the shortest synchronised LSPB within the velocity and acceleration limits;
+- ``ruckig``: time-optimal, jerk-limited rest-to-rest motion (free segments only: ruckig goes
+  state to state, it does not follow a Cartesian line);
+- ``ruckig_lspb_duration``: ruckig forced to the segment's LSPB duration (profile shape);
+- ``toppra``: time-optimal parameterisation of the same geometric joint path under joint
+  velocity and acceleration limits (free and straight-line segments).
+
+Every figure is measured on the sampled output, not taken from the libraries: peaks of |qd|,
+|qdd| and |jerk| (finite differences of the sampled acceleration), and limit violations. LSPB and
+toppra have piecewise-constant accelerations, so their jerk is impulsive: the sampled figure is
+the acceleration step divided by the sample period, and it is not counted as a violation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from lynxplan.constants import LIMIT_CHECK_RELATIVE_TOLERANCE, LIMIT_SNAP_TOLERANCE
+from lynxplan.exceptions import RetimingError
+from lynxplan.trajectory.free import FreeSegment
+from lynxplan.trajectory.limits import MotionLimits
+from lynxplan.trajectory.line import LineSegment
+from lynxplan.trajectory.lspb import LspbTiming
+from lynxplan.trajectory.plan import DEFAULT_SAMPLE_RATE, Plan
+from lynxplan.trajectory.timing import auto_timing_linear, auto_timing_path
+
+METHODS = ("lspb", "lspb_auto", "ruckig", "ruckig_lspb_duration", "toppra")
+#: Methods whose jerk is bounded by construction (the others' sampled jerk is impulsive).
+JERK_LIMITED_METHODS = ("ruckig", "ruckig_lspb_duration")
+
+
+class Profile(NamedTuple):
+    """A sampled joint trajectory of one segment (N samples, from 0 to the duration)."""
+
+    t: np.ndarray
+    """Time since the segment start, shape (N,), in [s]."""
+    q: np.ndarray
+    """Joint angles, shape (N, 5), in [rad]."""
+    qd: np.ndarray
+    """Joint velocities, shape (N, 5), in [rad/s]."""
+    qdd: np.ndarray
+    """Joint accelerations, shape (N, 5), in [rad/s^2]."""
+
+    @property
+    def jerk(self) -> np.ndarray:
+        """Forward differences of the sampled acceleration, shape (N, 5), in [rad/s^3]."""
+        if self.t.size < 2:
+            return np.zeros_like(self.qdd)
+        jerk = np.diff(self.qdd, axis=0) / np.diff(self.t)[:, None]
+        return np.vstack([jerk, jerk[-1:]])
+
+
+class ProfileStats(NamedTuple):
+    """Figures of one method on one segment, measured on its samples."""
+
+    method: str
+    """One of :data:`METHODS`."""
+    duration: float
+    """Duration, in [s]."""
+    peak_velocity: np.ndarray
+    """Peak |qd| per joint, shape (5,), in [rad/s]."""
+    peak_acceleration: np.ndarray
+    """Peak |qdd| per joint, shape (5,), in [rad/s^2]."""
+    peak_jerk: np.ndarray
+    """Peak sampled |jerk| per joint, shape (5,), in [rad/s^3] (impulsive for LSPB/toppra)."""
+    velocity_ratio: float
+    """Largest peak velocity / limit over joints (> 1 is a violation)."""
+    acceleration_ratio: float
+    """Largest peak acceleration / limit over joints (> 1 is a violation)."""
+    violations: tuple[str, ...]
+    """Human-readable limit violations (position, velocity, acceleration; jerk for ruckig)."""
+
+
+def sample_times(duration: float, rate: float) -> np.ndarray:
+    """Times 0, 1/rate, ... and the duration itself, shape (N,), in [s]."""
+    count = int(math.floor(duration * rate + 1e-9)) + 1
+    t = np.arange(count) / rate
+    return t if t[-1] >= duration - 1e-12 else np.append(t, duration)
+
+
+def lspb_profile(segment: FreeSegment | LineSegment, timing: LspbTiming, rate: float) -> Profile:
+    """The segment re-timed with ``timing`` and sampled at ``rate`` [Hz]."""
+    retimed = dataclasses.replace(segment, timing=timing)
+    t = sample_times(timing.tt, rate)
+    samples = retimed.sample(t)
+    return Profile(t, samples.q, samples.qd, samples.qdd)
+
+
+def auto_timing_of(segment: FreeSegment | LineSegment, limits: MotionLimits) -> LspbTiming:
+    """The shortest synchronised LSPB of the segment's path within ``limits``."""
+    if isinstance(segment, FreeSegment):
+        delta = segment.q_end - segment.q_start
+        return auto_timing_linear(delta, limits.velocity, limits.acceleration)
+    g = segment.grid
+    return auto_timing_path(g.s, g.dq_ds, g.d2q_ds2, limits.velocity, limits.acceleration)
+
+
+def ruckig_profile(
+    q_start: np.ndarray,
+    q_end: np.ndarray,
+    limits: MotionLimits,
+    rate: float,
+    minimum_duration: float | None = None,
+) -> Profile:
+    """Time-optimal jerk-limited rest-to-rest motion by ruckig, sampled at ``rate`` [Hz].
+
+    Args:
+        q_start: Start configuration, shape (5,), in [rad].
+        q_end: End configuration, shape (5,), in [rad].
+        limits: Velocity, acceleration and jerk limits.
+        rate: Sample rate, in [Hz].
+        minimum_duration: Force at least this duration, in [s] (e.g. the LSPB's tt).
+    """
+    from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
+
+    params = InputParameter(5)
+    params.current_position = list(map(float, q_start))
+    params.target_position = list(map(float, q_end))
+    params.current_velocity = params.current_acceleration = [0.0] * 5
+    params.target_velocity = params.target_acceleration = [0.0] * 5
+    params.max_velocity = list(map(float, limits.velocity))
+    params.max_acceleration = list(map(float, limits.acceleration))
+    params.max_jerk = list(map(float, limits.jerk))
+    if minimum_duration is not None:
+        params.minimum_duration = float(minimum_duration)
+    trajectory = Trajectory(5)
+    try:
+        result = Ruckig(5).calculate(params, trajectory)
+    except RuckigError as exc:
+        raise RetimingError("ruckig", str(exc).strip().splitlines()[0]) from exc
+    if result not in (Result.Working, Result.Finished):
+        raise RetimingError("ruckig", str(result))
+    t = sample_times(trajectory.duration, rate)
+    states = np.array([trajectory.at_time(float(x)) for x in t])  # (N, 3, 5)
+    return Profile(t, states[:, 0], states[:, 1], states[:, 2])
+
+
+def toppra_profile(
+    segment: FreeSegment | LineSegment, limits: MotionLimits, rate: float
+) -> Profile:
+    """Time-optimal parameterisation of the segment's joint path by toppra, sampled at ``rate``.
+
+    The path is a cubic spline through the segment's joint path on its grid (a straight joint
+    line for free motion). toppra enforces the limits on its grid points only: its sampled
+    output can exceed them slightly in between, which the statistics report.
+    """
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+
+    if isinstance(segment, LineSegment):
+        s, waypoints = segment.grid.s, segment.grid.q
+    else:
+        s = np.linspace(0.0, 1.0, 5)
+        waypoints = segment.joint_path(s)
+    if np.allclose(waypoints, waypoints[0], atol=1e-12, rtol=0):  # nothing to move
+        t = np.array([0.0])
+        zero = np.zeros((1, 5))
+        return Profile(t, waypoints[:1].copy(), zero, zero)
+    path = toppra.SplineInterpolator(s, waypoints)
+    velocity = toppra.constraint.JointVelocityConstraint(
+        np.column_stack([-limits.velocity, limits.velocity])
+    )
+    acceleration = toppra.constraint.JointAccelerationConstraint(
+        np.column_stack([-limits.acceleration, limits.acceleration])
+    )
+    algorithm = toppra.algorithm.TOPPRA(
+        [velocity, acceleration], path, parametrizer="ParametrizeConstAccel"
+    )
+    trajectory = algorithm.compute_trajectory(0.0, 0.0)
+    if trajectory is None:
+        raise RetimingError("toppra", "the path is not parameterisable under the limits")
+    t = sample_times(float(trajectory.duration), rate)
+    return Profile(t, trajectory(t), trajectory(t, 1), trajectory(t, 2))
+
+
+def profile_stats(method: str, profile: Profile, limits: MotionLimits) -> ProfileStats:
+    """Peaks and limit violations of a sampled profile."""
+    slack = 1.0 + LIMIT_CHECK_RELATIVE_TOLERANCE
+    peak_v = np.abs(profile.qd).max(axis=0)
+    peak_a = np.abs(profile.qdd).max(axis=0)
+    peak_j = np.abs(profile.jerk).max(axis=0)
+    violations: list[str] = []
+    lower, upper = limits.position[:, 0], limits.position[:, 1]
+    for j in range(5):
+        low, high = profile.q[:, j].min(), profile.q[:, j].max()
+        if low < lower[j] - LIMIT_SNAP_TOLERANCE or high > upper[j] + LIMIT_SNAP_TOLERANCE:
+            violations.append(f"q{j + 1} position [{low:.4f}, {high:.4f}] rad outside limits")
+        checks = [("velocity", peak_v, limits.velocity, "rad/s")]
+        checks.append(("acceleration", peak_a, limits.acceleration, "rad/s^2"))
+        if method in JERK_LIMITED_METHODS:
+            checks.append(("jerk", peak_j, limits.jerk, "rad/s^3"))
+        for name, peak, limit, unit in checks:
+            if peak[j] > limit[j] * slack:
+                violations.append(f"q{j + 1} {name} {peak[j]:.4f} > {limit[j]:.4g} {unit}")
+    return ProfileStats(
+        method,
+        float(profile.t[-1]),
+        peak_v,
+        peak_a,
+        peak_j,
+        float(np.max(peak_v / limits.velocity)),
+        float(np.max(peak_a / limits.acceleration)),
+        tuple(violations),
+    )
+
+
+class SegmentComparison(NamedTuple):
+    """Every applicable method on one segment."""
+
+    segment: int
+    """Segment index in the plan."""
+    kind: str
+    """``"free"`` or ``"line"``."""
+    stats: dict[str, ProfileStats]
+    """Method name -> figures (ruckig methods only on free segments)."""
+    profiles: dict[str, Profile]
+    """Method name -> sampled profile."""
+
+
+def compare_segment(
+    segment: FreeSegment | LineSegment,
+    limits: MotionLimits,
+    rate: float = DEFAULT_SAMPLE_RATE,
+    index: int = 0,
+) -> SegmentComparison:
+    """Run every applicable method on ``segment`` and measure the samples."""
+    profiles = {
+        "lspb": lspb_profile(segment, segment.timing, rate),
+        "lspb_auto": lspb_profile(segment, auto_timing_of(segment, limits), rate),
+    }
+    if isinstance(segment, FreeSegment):
+        profiles["ruckig"] = ruckig_profile(segment.q_start, segment.q_end, limits, rate)
+        profiles["ruckig_lspb_duration"] = ruckig_profile(
+            segment.q_start, segment.q_end, limits, rate, minimum_duration=segment.duration
+        )
+    profiles["toppra"] = toppra_profile(segment, limits, rate)
+    stats = {name: profile_stats(name, p, limits) for name, p in profiles.items()}
+    return SegmentComparison(index, segment.kind, stats, profiles)
+
+
+class PlanComparison(NamedTuple):
+    """Per-segment comparisons and whole-plan totals."""
+
+    segments: list[SegmentComparison]
+    """One comparison per segment."""
+    total_duration: dict[str, float]
+    """Method -> sum of durations over the segments it applies to, in [s]."""
+    segments_covered: dict[str, int]
+    """Method -> number of segments it applies to."""
+    peak_velocity: dict[str, np.ndarray]
+    """Method -> peak |qd| per joint over the plan, shape (5,), in [rad/s]."""
+    peak_acceleration: dict[str, np.ndarray]
+    """Method -> peak |qdd| per joint over the plan, shape (5,), in [rad/s^2]."""
+    violation_count: dict[str, int]
+    """Method -> number of segments with a limit violation."""
+
+
+def compare_plan(plan: Plan, rate: float = DEFAULT_SAMPLE_RATE) -> PlanComparison:
+    """Compare every method on every segment of ``plan`` (limits: the plan's)."""
+    comparisons = [
+        compare_segment(seg, plan.limits, rate, i) for i, seg in enumerate(plan.segments)
+    ]
+    totals: dict[str, float] = {}
+    covered: dict[str, int] = {}
+    peak_v: dict[str, np.ndarray] = {}
+    peak_a: dict[str, np.ndarray] = {}
+    violated: dict[str, int] = {}
+    for comparison in comparisons:
+        for name, stats in comparison.stats.items():
+            totals[name] = totals.get(name, 0.0) + stats.duration
+            covered[name] = covered.get(name, 0) + 1
+            peak_v[name] = np.maximum(peak_v.get(name, 0.0), stats.peak_velocity)
+            peak_a[name] = np.maximum(peak_a.get(name, 0.0), stats.peak_acceleration)
+            violated[name] = violated.get(name, 0) + bool(stats.violations)
+    return PlanComparison(comparisons, totals, covered, peak_v, peak_a, violated)
