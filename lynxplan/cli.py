@@ -17,6 +17,7 @@ from lynxplan.exceptions import LynxplanError
 COMMAND_MODULES = (
     "lynxplan.commands.run",
     "lynxplan.commands.bench",
+    "lynxplan.commands.parallel",
 )
 
 
