@@ -22,6 +22,7 @@ KIND_MODULES: dict[str, str] = {
     "workspace": "lynxplan.arm.workspace_scenario",
     "parallel_ik": "lynxplan.parallel.ik_scenario",
     "parallel_workspace": "lynxplan.parallel.workspace_scenario",
+    "trajectory": "lynxplan.trajectory.scenario",
 }
 
 

@@ -130,6 +130,28 @@ def _ik_nearest(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.n
     return select_continuous(ik.q, ik.within_limits, q_near)[0][0]
 
 
+def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) -> Segment:
+    if (spec.target_q is None) == (spec.target_pose is None):
+        raise InputError(f"segment {i}: give exactly one of target_q and target_pose")
+    if spec.kind == "free":
+        target = (
+            as_configuration(spec.target_q, f"segments[{i}].target_q")
+            if spec.target_q is not None
+            else _ik_nearest(spec.target_pose, q, lim)  # type: ignore[arg-type]
+        )
+        return free_segment(q, target, spec.timing, limits=lim)
+    if spec.kind == "line":
+        T_end = (
+            forward_kinematics(as_configuration(spec.target_q, f"segments[{i}].target_q"))
+            if spec.target_q is not None
+            else np.asarray(spec.target_pose, dtype=float)
+        )
+        return line_segment(
+            forward_kinematics(q), T_end, q, spec.timing, mode=spec.mode, limits=lim
+        )
+    raise InputError(f"segment {i}: unknown kind {spec.kind!r}; valid kinds: free, line")
+
+
 def build_plan(
     q_start: np.ndarray | list[float],
     specs: list[SegmentSpec] | tuple[SegmentSpec, ...],
@@ -152,26 +174,11 @@ def build_plan(
     q = as_configuration(q_start, "q_start")
     segments: list[Segment] = []
     for i, spec in enumerate(specs):
-        if (spec.target_q is None) == (spec.target_pose is None):
-            raise InputError(f"segment {i}: give exactly one of target_q and target_pose")
-        if spec.kind == "free":
-            target = (
-                as_configuration(spec.target_q, f"segments[{i}].target_q")
-                if spec.target_q is not None
-                else _ik_nearest(spec.target_pose, q, lim)  # type: ignore[arg-type]
-            )
-            segment: Segment = free_segment(q, target, spec.timing, limits=lim)
-        elif spec.kind == "line":
-            T_end = (
-                forward_kinematics(as_configuration(spec.target_q, f"segments[{i}].target_q"))
-                if spec.target_q is not None
-                else np.asarray(spec.target_pose, dtype=float)
-            )
-            segment = line_segment(
-                forward_kinematics(q), T_end, q, spec.timing, mode=spec.mode, limits=lim
-            )
-        else:
-            raise InputError(f"segment {i}: unknown kind {spec.kind!r}; valid kinds: free, line")
+        try:
+            segment = _build_segment(i, spec, q, lim)
+        except PathNotFollowableError as exc:
+            what = f"segment {i} ({spec.kind})"
+            raise PathNotFollowableError(exc.s, exc.reach_miss, what) from exc
         segments.append(segment)
         q = segment.q_end
     return Plan(tuple(segments), lim)

@@ -101,5 +101,5 @@ def test_errors(ok_plan) -> None:
         ok_plan.sample(0.0)
     far = np.eye(4)
     far[:3, 3] = [0, 2.0, 0]
-    with pytest.raises(PathNotFollowableError, match="target pose leaves the arm's reach"):
+    with pytest.raises(PathNotFollowableError, match=r"segment 0 \(free\) leaves the arm.s reach"):
         build_plan(q[0], [SegmentSpec("free", target_pose=far)])

@@ -1,0 +1,295 @@
+"""Scenario kind ``trajectory``: a list of segments, sampled and compared with ruckig and toppra.
+
+Example (``scenarios/free_motion.yaml``)::
+
+    kind: trajectory
+    units: {length: in, angle: rad}
+    start: [0, 0, 0, 0, 0]               # joint angles, in the file's angle unit
+    limits: {acceleration: 8.0, jerk: 60.0}   # per joint (scalar or 5 values), angle unit/s^n
+    sample_rate: 1000                     # [Hz]
+    segments:
+      - motion: free                      # or: line (with orientation: consistent|slerp|lerp|drive)
+        to_q: [1.2, 0.9, -0.68, 1, 0]     # or to_pose: 3 or 4 rows of 4 (file's length unit)
+        tt: 3.0                           # [s]; omit tt and ta for the shortest LSPB
+        ta: 1.0
+    plot: {segment: 0, joint: 2}          # the report's q2(t) figure: segment index, joint 1..5
+    expect: {max_line_deviation: 1.0e-9, joint_limits_respected: true}
+
+Velocity limits come from the URDF. Outputs: ``report.json`` (per-segment figures and the
+comparison table) and, unless quick, ``joint_profiles.png``, ``tool_xyz.png`` and
+``durations.png``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+from typing import Any, Literal
+
+import numpy as np
+from pydantic import Field, model_validator
+
+from lynxplan.arm.kinematics import forward_kinematics
+from lynxplan.scenario import Outcome, StrictModel, Units
+from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, MotionLimits
+from lynxplan.trajectory.lspb import LspbTiming
+from lynxplan.trajectory.plan import (
+    DEFAULT_SAMPLE_RATE,
+    Plan,
+    PlanSamples,
+    SegmentReport,
+    SegmentSpec,
+    build_plan,
+    segment_reports,
+)
+from lynxplan.units import angle_factor, length_factor
+
+PerJoint = float | list[float]
+
+
+class SegmentEntry(StrictModel):
+    """One segment of the scenario."""
+
+    motion: Literal["free", "line"] = Field(description="Joint-space or Cartesian straight line.")
+    to_q: list[float] | None = Field(default=None, min_length=5, max_length=5)
+    to_pose: list[list[float]] | None = Field(default=None, min_length=3, max_length=4)
+    tt: float | None = Field(default=None, description="Total time, in [s].")
+    ta: float | None = Field(default=None, description="Blend time, in [s].")
+    orientation: Literal["consistent", "slerp", "lerp", "drive"] = "consistent"
+
+    @model_validator(mode="after")
+    def _one_target_and_timing(self) -> SegmentEntry:
+        if (self.to_q is None) == (self.to_pose is None):
+            raise ValueError("give exactly one of to_q and to_pose")
+        if (self.tt is None) != (self.ta is None):
+            raise ValueError("give both tt and ta, or neither (shortest LSPB within the limits)")
+        if self.to_pose is not None and any(len(row) != 4 for row in self.to_pose):
+            raise ValueError("to_pose rows must have 4 values")
+        if self.tt is not None and self.ta is not None:
+            LspbTiming(self.tt, self.ta)  # TimingError (a ValueError) names the problem
+        return self
+
+    def spec(self, units: Units) -> SegmentSpec:
+        """The plan's :class:`SegmentSpec`, in SI units."""
+        timing = None if self.tt is None or self.ta is None else LspbTiming(self.tt, self.ta)
+        target_q = target_pose = None
+        if self.to_q is not None:
+            target_q = np.array(self.to_q) * angle_factor(units.angle)
+        else:
+            target_pose = np.eye(4)
+            target_pose[: len(self.to_pose or []), :] = np.array(self.to_pose)
+            target_pose[:3, 3] *= length_factor(units.length)
+        return SegmentSpec(self.motion, target_q, target_pose, timing, self.orientation)
+
+
+class LimitsEntry(StrictModel):
+    """Acceleration and jerk limits per joint, in the file's angle unit per s^2 / s^3."""
+
+    acceleration: PerJoint | None = Field(
+        default=None, description=f"Default {DEFAULT_MAX_ACCELERATION} rad/s^2."
+    )
+    jerk: PerJoint | None = Field(default=None, description=f"Default {DEFAULT_MAX_JERK} rad/s^3.")
+
+    def build(self, units: Units) -> MotionLimits:
+        """:class:`MotionLimits` in SI (velocity from the URDF defaults)."""
+        factor = angle_factor(units.angle)
+        acc = DEFAULT_MAX_ACCELERATION if self.acceleration is None else self.acceleration
+        jerk = DEFAULT_MAX_JERK if self.jerk is None else self.jerk
+        scale = 1.0 if self.acceleration is None else factor
+        jerk_scale = 1.0 if self.jerk is None else factor
+        return MotionLimits(
+            acceleration=np.asarray(acc, dtype=float) * scale,
+            jerk=np.asarray(jerk, dtype=float) * jerk_scale,
+        )
+
+
+class PlotEntry(StrictModel):
+    """Which segment and joint the joint-profile figure shows."""
+
+    segment: int = Field(default=0, ge=0)
+    joint: int = Field(default=2, ge=1, le=5, description="1-based joint number (q2 default).")
+
+
+class Expect(StrictModel):
+    """Expected results (all optional)."""
+
+    max_line_deviation: float | None = Field(
+        default=None, gt=0, description="Largest tool-point deviation from lines, in [m]."
+    )
+    joint_limits_respected: bool | None = None
+    max_branch_switches: int | None = Field(default=None, ge=0)
+
+
+class Scenario(StrictModel):
+    """A ``trajectory`` scenario."""
+
+    kind: Literal["trajectory"]
+    name: str = ""
+    units: Units = Units(length="m", angle="rad")
+    start: list[float] = Field(min_length=5, max_length=5)
+    segments: list[SegmentEntry] = Field(min_length=1)
+    limits: LimitsEntry = Field(default_factory=LimitsEntry)
+    sample_rate: float = Field(default=DEFAULT_SAMPLE_RATE, gt=0, le=1e5)
+    compare: bool = Field(default=True, description="Run the ruckig and toppra comparisons.")
+    plot: PlotEntry = Field(default_factory=PlotEntry)
+    expect: Expect = Field(default_factory=Expect)
+
+    @model_validator(mode="after")
+    def _plot_segment_exists(self) -> Scenario:
+        if self.plot.segment >= len(self.segments):
+            raise ValueError(
+                f"plot.segment {self.plot.segment} does not exist "
+                f"(there are {len(self.segments)} segments)"
+            )
+        return self
+
+
+def build(scenario: Scenario) -> Plan:
+    """The scenario's plan (SI units)."""
+    start = np.array(scenario.start) * angle_factor(scenario.units.angle)
+    specs = [entry.spec(scenario.units) for entry in scenario.segments]
+    return build_plan(start, specs, scenario.limits.build(scenario.units))
+
+
+def _report_json(
+    scenario: Scenario, plan: Plan, reports: list[SegmentReport], comparison: Any
+) -> dict[str, Any]:
+    limits = plan.limits
+    segments = []
+    for report in reports:
+        entry: dict[str, Any] = report._asdict()
+        if comparison is not None:
+            entry["comparison"] = {
+                name: {
+                    "duration_s": s.duration,
+                    "peak_velocity_rad_s": s.peak_velocity.tolist(),
+                    "peak_acceleration_rad_s2": s.peak_acceleration.tolist(),
+                    "peak_jerk_rad_s3": s.peak_jerk.tolist(),
+                    "velocity_ratio": s.velocity_ratio,
+                    "acceleration_ratio": s.acceleration_ratio,
+                    "violations": list(s.violations),
+                }
+                for name, s in comparison.segments[report.segment].stats.items()
+            }
+        segments.append(entry)
+    out: dict[str, Any] = {
+        "name": scenario.name,
+        "sample_rate_hz": scenario.sample_rate,
+        "duration_s": plan.duration,
+        "limits": {
+            "position_rad": limits.position.tolist(),
+            "velocity_rad_s": limits.velocity.tolist(),
+            "acceleration_rad_s2": limits.acceleration.tolist(),
+            "jerk_rad_s3": limits.jerk.tolist(),
+        },
+        "segments": segments,
+    }
+    if comparison is not None:
+        out["plan_comparison"] = {
+            name: {
+                "total_duration_s": comparison.total_duration[name],
+                "segments_covered": comparison.segments_covered[name],
+                "peak_velocity_rad_s": comparison.peak_velocity[name].tolist(),
+                "peak_acceleration_rad_s2": comparison.peak_acceleration[name].tolist(),
+                "segments_with_violations": comparison.violation_count[name],
+            }
+            for name in comparison.total_duration
+        }
+        out["notes"] = [
+            "ruckig applies to free segments only (it does not follow a Cartesian line).",
+            "LSPB and toppra accelerations are piecewise constant: their sampled jerk is the "
+            "acceleration step over the sample period (impulsive), not a limit violation.",
+            "toppra enforces the limits on its grid points; its sampled output may exceed them "
+            "slightly in between (see velocity_ratio / acceleration_ratio).",
+        ]
+    return out
+
+
+def _check(scenario: Scenario, reports: list[SegmentReport]) -> list[str]:
+    expect = scenario.expect
+    failed = []
+    for r in reports:
+        if (
+            expect.max_line_deviation is not None
+            and r.max_line_deviation is not None
+            and r.max_line_deviation > expect.max_line_deviation
+        ):
+            failed.append(
+                f"segments[{r.segment}]: line deviation {r.max_line_deviation:.3g} m exceeds "
+                f"{expect.max_line_deviation:.3g} m"
+            )
+        if expect.joint_limits_respected and r.limit_violation_samples:
+            joints = ", ".join(f"q{j + 1}" for j in r.limit_violation_joints)
+            failed.append(
+                f"segments[{r.segment}]: {r.limit_violation_samples} samples outside the joint "
+                f"limits ({joints})"
+            )
+        if (
+            expect.max_branch_switches is not None
+            and r.branch_switches > expect.max_branch_switches
+        ):
+            failed.append(f"segments[{r.segment}]: {r.branch_switches} IK branch switches")
+    return failed
+
+
+def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Outcome:
+    """Build, sample and compare the plan; write ``report.json`` and the plots."""
+    plan = build(scenario)
+    samples = plan.sample(scenario.sample_rate)
+    reports = segment_reports(plan, samples)
+    comparison = None
+    if scenario.compare:
+        from lynxplan.trajectory.retime import compare_plan
+
+        comparison = compare_plan(plan, scenario.sample_rate)
+    if out_dir is not None:
+        data = _report_json(scenario, plan, reports, comparison)
+        (out_dir / "report.json").write_text(json.dumps(_finite(data), indent=2))
+        if not quick:
+            _write_plots(scenario, plan, samples, comparison, out_dir)
+    return Outcome(_summary(scenario, plan, reports, comparison), tuple(_check(scenario, reports)))
+
+
+def _write_plots(
+    scenario: Scenario, plan: Plan, samples: PlanSamples, comparison: Any, out_dir: Path
+) -> None:
+    from lynxplan.trajectory import plots
+
+    index, joint = scenario.plot.segment, scenario.plot.joint - 1
+    if comparison is not None:
+        plots.plot_joint_profiles(comparison.segments[index], joint, out_dir / "joint_profiles.png")
+        plots.plot_durations(comparison, out_dir / "durations.png")
+    lines = [i for i, seg in enumerate(plan.segments) if seg.kind == "line"]
+    if lines:
+        plots.plot_tool_xyz(plan, samples, lines[0], out_dir / "tool_xyz.png")
+
+
+def _finite(value: Any) -> Any:
+    """JSON has no NaN/inf: replace them by None."""
+    if isinstance(value, float):
+        return value if math.isfinite(value) else None
+    if isinstance(value, dict):
+        return {k: _finite(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_finite(v) for v in value]
+    return value
+
+
+def _summary(scenario: Scenario, plan: Plan, reports: list[SegmentReport], comparison: Any) -> str:
+    lines = [r for r in reports if r.max_line_deviation is not None]
+    text = (
+        f"trajectory {scenario.name or ''}: {len(plan.segments)} segments, "
+        f"{plan.duration:.3f} s planned"
+    )
+    if lines:
+        deviation = max(r.max_line_deviation or 0.0 for r in lines)
+        text += f"; largest line deviation {deviation:.2e} m"
+    violations = sum(r.limit_violation_samples for r in reports)
+    text += f"; {violations} samples outside joint limits"
+    if comparison is not None:
+        totals = ", ".join(f"{k} {v:.3f} s" for k, v in comparison.total_duration.items())
+        text += f"; durations: {totals}"
+    start = forward_kinematics(np.array(scenario.start) * angle_factor(scenario.units.angle))
+    text += f"; start tool point {np.round(start[:3, 3], 4).tolist()} m"
+    return text

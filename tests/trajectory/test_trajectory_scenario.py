@@ -1,0 +1,111 @@
+"""Scenario kind ``trajectory``: the shipped files, outputs, expectations and errors."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from lynxplan.cli import main
+from lynxplan.exceptions import PathNotFollowableError, ScenarioError
+from lynxplan.runner import run_scenario
+
+SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
+SHIPPED = ["free_motion.yaml", "straight_line.yaml"]
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_shipped_scenarios_run_and_hold_their_expectations(name: str, tmp_path: Path) -> None:
+    outcome = run_scenario(SCENARIOS / name, tmp_path, quick=True)
+    assert outcome.ok, outcome.failed_expectations
+    report = json.loads((tmp_path / "report.json").read_text())
+    segment = report["segments"][0]
+    assert segment["tt"] == 3.0 and segment["ta"] == 1.0
+    assert segment["limit_violation_samples"] == 0
+    assert {"lspb", "lspb_auto", "toppra"} <= set(segment["comparison"])
+    assert report["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
+
+
+def test_free_motion_report_matches_the_lspb_formulas(tmp_path: Path) -> None:
+    run_scenario(SCENARIOS / "free_motion.yaml", tmp_path, quick=True)
+    stats = json.loads((tmp_path / "report.json").read_text())["segments"][0]["comparison"]
+    # dA / T with T = tt - ta = 2 s and dA / (T ta) for the report's example.
+    delta = [1.2, 0.9, 0.68, 1.0, 0.0]
+    assert stats["lspb"]["peak_velocity_rad_s"] == pytest.approx([d / 2 for d in delta], abs=1e-9)
+    assert stats["lspb"]["peak_acceleration_rad_s2"] == pytest.approx(
+        [d / 2 for d in delta], abs=1e-9
+    )
+    assert stats["ruckig_lspb_duration"]["duration_s"] == pytest.approx(3.0)
+    assert stats["ruckig"]["violations"] == []
+
+
+def test_plots_are_written_unless_quick(tmp_path: Path) -> None:
+    outcome = run_scenario(SCENARIOS / "straight_line.yaml", tmp_path)
+    assert outcome.ok
+    for png in ("joint_profiles.png", "tool_xyz.png", "durations.png"):
+        assert (tmp_path / png).stat().st_size > 10_000, png
+
+
+def _write(tmp_path: Path, body: str) -> Path:
+    path = tmp_path / "scenario.yaml"
+    path.write_text("kind: trajectory\nstart: [0.0, 0.3, -0.5, 1.0, 0.2]\n" + body)
+    return path
+
+
+def test_failed_expectations_are_listed(tmp_path: Path) -> None:
+    # The letter O's first stroke with a full-SO(3) slerp: the roll dips below its 0 deg limit.
+    path = tmp_path / "o1_o2.yaml"
+    path.write_text(
+        "kind: trajectory\nunits: {angle: deg}\nstart: [104, 57, -59, 40, 0]\ncompare: false\n"
+        "segments:\n  - {motion: line, to_q: [109, 79, -93, 25, 0], orientation: slerp,"
+        " tt: 2, ta: 0.5}\nexpect: {joint_limits_respected: true}\n"
+    )
+    outcome = run_scenario(path, None)
+    assert not outcome.ok
+    assert "samples outside the joint limits (q5)" in outcome.failed_expectations[0]
+
+
+Q0 = "to_q: [0, 0, 0, 0, 0]"
+INVALID = [
+    (f"segments: [{{motion: free, {Q0}, tt: 1.0}}]", "segments[0]", "both tt and ta"),
+    (f"segments: [{{motion: free, {Q0}, tt: 1.0, ta: 0.6}}]", "segments[0]", "blends overlap"),
+    (
+        "segments: [{motion: free, tt: 1, ta: 0.2}]",
+        "segments[0]",
+        "exactly one of to_q and to_pose",
+    ),
+    (f"segments: [{{motion: jump, {Q0}}}]", "segments[0].motion", "Input should be"),
+    (
+        f"segments: [{{motion: line, {Q0}, orientation: spline}}]",
+        "segments[0].orientation",
+        "Input should be",
+    ),
+    (f"segments: [{{motion: free, {Q0}}}]\nplot: {{segment: 3}}", "", "plot.segment 3 does not"),
+    ("segments: []", "segments", "at least 1 item"),
+]
+
+
+@pytest.mark.parametrize(("body", "location", "reason"), INVALID)
+def test_invalid_scenarios_name_the_key(
+    tmp_path: Path, body: str, location: str, reason: str
+) -> None:
+    with pytest.raises(ScenarioError, match=reason) as info:
+        run_scenario(_write(tmp_path, body), None)
+    assert info.value.location == location
+
+
+def test_unreachable_target_names_the_segment(tmp_path: Path) -> None:
+    body = "segments: [{motion: line, to_pose: [[1, 0, 0, 5], [0, -1, 0, 0], [0, 0, -1, 0]]}]\n"
+    with pytest.raises(PathNotFollowableError, match=r"segment 0 \(line\) leaves the arm's reach"):
+        run_scenario(_write(tmp_path, body), None)
+
+
+def test_cli_runs_a_scenario_and_reports_bad_input(tmp_path: Path, capsys) -> None:
+    assert (
+        main(["run", str(SCENARIOS / "free_motion.yaml"), "--out", str(tmp_path), "--quick"]) == 0
+    )
+    assert "trajectory free motion" in capsys.readouterr().out
+    bad = _write(tmp_path, "segments: [{motion: free, to_q: [0, 0, 0, 0, 0], tt: -1, ta: 0.5}]")
+    assert main(["run", str(bad), "--out", str(tmp_path / "x")]) == 2
+    assert "tt must be positive" in capsys.readouterr().err
