@@ -14,6 +14,8 @@ from typing import NamedTuple
 #: Section name -> module with ``run(quick) -> list[Figure]``.
 SECTIONS: dict[str, str] = {
     "arm": "lynxplan.bench.arm",
+    "parallel": "lynxplan.bench.parallel",
+    "trajectory": "lynxplan.bench.trajectory",
 }
 
 
