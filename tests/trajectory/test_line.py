@@ -159,3 +159,11 @@ def test_path_leaving_the_reach_names_where() -> None:
         line_segment(T0, T1, q0, REPORT)
     assert 0.3 < info.value.s < 0.7
     assert info.value.reach_miss > 0.0
+
+
+def test_zero_length_line_is_stationary() -> None:
+    T0 = forward_kinematics(Q[0])
+    segment = line_segment(T0, T0, Q[0])  # auto-timed: the stationary timing
+    samples = segment.sample(np.linspace(0, segment.duration, 5))
+    np.testing.assert_allclose(samples.q, np.tile(Q[0], (5, 1)), atol=1e-12)
+    np.testing.assert_allclose(samples.qd, 0.0, atol=1e-9)
