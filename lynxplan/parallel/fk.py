@@ -32,6 +32,7 @@ from __future__ import annotations
 import math
 from typing import NamedTuple
 
+import numba
 import numpy as np
 
 from lynxplan.constants import (
@@ -46,7 +47,7 @@ from lynxplan.exceptions import (
     ShapeError,
 )
 from lynxplan.parallel.geometry import PLATFORM_PHASES, ParallelGeometry
-from lynxplan.parallel.ik import WORKING_MODES, elbows, solve_ik_batch
+from lynxplan.parallel.ik import WORKING_MODES, elbows, kernel_constants
 
 _DEFAULT_GEOMETRY = ParallelGeometry()
 _SAMPLES = 16
@@ -104,66 +105,214 @@ def closure_polynomial(
     return np.asarray(x * x + y * y - distal**2 * d * d)
 
 
+@numba.njit(cache=True, nogil=True)
+def sextic_kernel(
+    elbow: np.ndarray, phase: np.ndarray, rp: float, el: float, out: np.ndarray
+) -> None:
+    """Coefficients of ``z^3 f(z)`` (highest power first) for elbows (N, 3, 2) into ``out``
+    (N, 7): the DFT of 16 samples of ``f`` (exact for a trigonometric polynomial of degree 3)."""
+    samples = np.empty(_SAMPLES)
+    ax = np.empty(3)
+    ay = np.empty(3)
+    for n in range(elbow.shape[0]):
+        for j in range(_SAMPLES):
+            alpha = 2.0 * math.pi * j / _SAMPLES
+            ca, sa = math.cos(alpha), math.sin(alpha)
+            for i in range(3):
+                ax[i] = elbow[n, i, 0] + rp * (ca * phase[i, 0] - sa * phase[i, 1])
+                ay[i] = elbow[n, i, 1] + rp * (sa * phase[i, 0] + ca * phase[i, 1])
+            m00, m01 = 2.0 * (ax[1] - ax[0]), 2.0 * (ay[1] - ay[0])
+            m10, m11 = 2.0 * (ax[2] - ax[0]), 2.0 * (ay[2] - ay[0])
+            a0 = ax[0] * ax[0] + ay[0] * ay[0]
+            b0 = ax[1] * ax[1] + ay[1] * ay[1] - a0
+            b1 = ax[2] * ax[2] + ay[2] * ay[2] - a0
+            d = m00 * m11 - m01 * m10
+            x = b0 * m11 - b1 * m01 - ax[0] * d
+            y = m00 * b1 - m10 * b0 - ay[0] * d
+            samples[j] = x * x + y * y - el * el * d * d
+        for k in range(-3, 4):
+            acc = 0.0 + 0.0j
+            for j in range(_SAMPLES):
+                angle = -2.0 * math.pi * k * j / _SAMPLES
+                acc += samples[j] * complex(math.cos(angle), math.sin(angle))
+            out[n, 3 - k] = acc / _SAMPLES
+
+
 def sextic_coefficients(elbow: np.ndarray, geometry: ParallelGeometry) -> np.ndarray:
     """Coefficients of ``z^3 f(z)``, highest power first, shape (N, 7), from elbows (N, 3, 2)."""
-    alpha = np.broadcast_to(
-        np.arange(_SAMPLES) * (2.0 * math.pi / _SAMPLES), (elbow.shape[0], _SAMPLES)
+    _, phase = kernel_constants(geometry)
+    out = np.empty((elbow.shape[0], 7), dtype=np.complex128)
+    sextic_kernel(
+        np.ascontiguousarray(elbow), phase, geometry.platform_circumradius, geometry.distal, out
     )
-    f = closure_polynomial(elbow, alpha, geometry.distal, geometry.platform_circumradius)
-    c = np.fft.fft(f, axis=-1) / _SAMPLES  # c[k] multiplies exp(i k alpha); c[-k] = conj(c[k])
-    # z^3 f = sum_{k=-3..3} c_k z^(k+3); highest power (k = 3) first.
-    return np.concatenate([c[:, 3::-1], c[:, -1:-4:-1]], axis=1)
+    return out
 
 
-def _roots(coefficients: np.ndarray) -> list[np.ndarray]:
-    """All roots of each polynomial (N, 7): batched companion eigenvalues, or np.roots."""
-    scale = np.max(np.abs(coefficients), axis=1)
-    lead = coefficients[:, 0]
-    regular = np.abs(lead) > 1e-9 * scale
-    result: list[np.ndarray] = [np.empty(0, dtype=complex)] * coefficients.shape[0]
-    index = np.flatnonzero(regular)
-    if index.size:
-        companion = np.zeros((index.size, 6, 6), dtype=complex)
-        companion[:, 0, :] = -coefficients[index, 1:] / lead[index, None]
-        companion[:, np.arange(1, 6), np.arange(5)] = 1.0
-        eig = np.linalg.eigvals(companion)
-        for j, n in enumerate(index):
-            result[n] = eig[j]
-    for n in np.flatnonzero(~regular):
-        trimmed = np.where(np.abs(coefficients[n]) > 1e-13 * scale[n], coefficients[n], 0.0)
-        result[n] = np.roots(trimmed) if np.any(trimmed) else np.empty(0, dtype=complex)
-    return result
+@numba.njit(cache=True, nogil=True)
+def _wrap(angle: float) -> float:
+    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
-def _centres(elbow: np.ndarray, alpha: np.ndarray, geometry: ParallelGeometry) -> np.ndarray:
-    """Platform centre for each (elbow set (K, 3, 2), alpha (K,)): intersection of leg circles
-    1 and 2 that lies closest to circle 3, shape (K, 2)."""
-    a = _anchors(elbow, alpha[:, None], geometry.platform_circumradius)[:, 0]
-    el = geometry.distal
-    chord = a[:, 1] - a[:, 0]
-    length = np.maximum(np.linalg.norm(chord, axis=1), 1e-300)
-    half = np.sqrt(np.maximum(el * el - (length / 2) ** 2, 0.0))
-    mid = (a[:, 0] + a[:, 1]) / 2
-    normal = np.stack([-chord[:, 1], chord[:, 0]], axis=1) / length[:, None]
-    candidates = np.stack([mid + half[:, None] * normal, mid - half[:, None] * normal], axis=1)
-    miss = np.abs(np.linalg.norm(candidates - a[:, None, 2], axis=2) - el)
-    return candidates[np.arange(len(alpha)), np.argmin(miss, axis=1)]
-
-
-def _newton(elbow: np.ndarray, poses: np.ndarray, geometry: ParallelGeometry) -> np.ndarray:
-    """Polish poses (K, 3) on the closure equations |c - A_i(alpha)|^2 = L^2 (pseudo-inverse
-    steps, so a singular Jacobian at a Type II singularity does not blow up)."""
-    rp, el = geometry.platform_circumradius, geometry.distal
-    phases = np.array(PLATFORM_PHASES)
+@numba.njit(cache=True, nogil=True)
+def _closure_newton(
+    elbow: np.ndarray, pose: np.ndarray, phase: np.ndarray, rp: float, el: float
+) -> None:
+    """Polish ``pose`` (3,) in place on the closure equations |c - A_i(alpha)|^2 = L^2
+    (Levenberg-damped Gauss-Newton steps, so a singular Jacobian at a Type II singularity does
+    not blow up); scalar code, no allocation."""
     for _ in range(_NEWTON_STEPS):
-        phi = poses[:, 2:3] + phases
-        a = elbow + rp * np.stack([np.cos(phi), np.sin(phi)], axis=-1)
-        r = poses[:, None, :2] - a
-        g = np.sum(r * r, axis=-1) - el * el
-        da = rp * np.stack([-np.sin(phi), np.cos(phi)], axis=-1)
-        jac = np.concatenate([2 * r, -2 * np.sum(r * da, axis=-1, keepdims=True)], axis=-1)
-        poses = poses - np.einsum("kij,kj->ki", np.linalg.pinv(jac, rcond=1e-12), g)
-    return poses
+        ca, sa = math.cos(pose[2]), math.sin(pose[2])
+        # Normal equations (J^T J + mu I) step = J^T g, accumulated row by row.
+        n00 = n01 = n02 = n11 = n12 = n22 = 0.0
+        r0 = r1 = r2 = 0.0
+        for i in range(3):
+            cphi = ca * phase[i, 0] - sa * phase[i, 1]
+            sphi = sa * phase[i, 0] + ca * phase[i, 1]
+            rx = pose[0] - elbow[i, 0] - rp * cphi
+            ry = pose[1] - elbow[i, 1] - rp * sphi
+            g = rx * rx + ry * ry - el * el
+            j0, j1, j2 = 2.0 * rx, 2.0 * ry, -2.0 * rp * (-rx * sphi + ry * cphi)
+            n00 += j0 * j0
+            n01 += j0 * j1
+            n02 += j0 * j2
+            n11 += j1 * j1
+            n12 += j1 * j2
+            n22 += j2 * j2
+            r0 += j0 * g
+            r1 += j1 * g
+            r2 += j2 * g
+        mu = 1e-14 * (n00 + n11 + n22) + 1e-300
+        n00 += mu
+        n11 += mu
+        n22 += mu
+        # Cramer's rule on the symmetric 3x3 system.
+        c00 = n11 * n22 - n12 * n12
+        c01 = n02 * n12 - n01 * n22
+        c02 = n01 * n12 - n02 * n11
+        det = n00 * c00 + n01 * c01 + n02 * c02
+        pose[0] -= (r0 * c00 + r1 * c01 + r2 * c02) / det
+        pose[1] -= (r0 * c01 + r1 * (n00 * n22 - n02 * n02) + r2 * (n01 * n02 - n00 * n12)) / det
+        pose[2] -= (r0 * c02 + r1 * (n01 * n02 - n00 * n12) + r2 * (n00 * n11 - n01 * n01)) / det
+
+
+@numba.njit(cache=True, nogil=True)
+def _verify(
+    pose: np.ndarray,
+    theta: np.ndarray,
+    base: np.ndarray,
+    phase: np.ndarray,
+    rp: float,
+    s: float,
+    el: float,
+) -> tuple[float, int]:
+    """Largest |IK(pose) - theta| (wrapped) in the best-matching working mode, and that mode."""
+    worst, mode = 0.0, 0
+    ca, sa = math.cos(pose[2]), math.sin(pose[2])
+    for i in range(3):
+        cphi = ca * phase[i, 0] - sa * phase[i, 1]
+        sphi = sa * phase[i, 0] + ca * phase[i, 1]
+        dx = pose[0] - rp * cphi - base[i, 0]
+        dy = pose[1] - rp * sphi - base[i, 1]
+        dist = math.sqrt(dx * dx + dy * dy)
+        if dist == 0.0:
+            return math.inf, 0
+        arg = min(1.0, max(-1.0, (s * s - el * el + dist * dist) / (2.0 * s * dist)))
+        half = math.acos(arg)
+        direction = math.atan2(dy, dx)
+        plus = abs(_wrap(direction + half - theta[i]))
+        minus = abs(_wrap(direction - half - theta[i]))
+        if minus < plus:
+            mode |= 1 << (2 - i)
+        worst = max(worst, min(plus, minus))
+    return worst, mode
+
+
+@numba.njit(cache=True, nogil=True)
+def fk_kernel(
+    coefficients: np.ndarray,
+    elbow: np.ndarray,
+    theta: np.ndarray,
+    base: np.ndarray,
+    phase: np.ndarray,
+    rp: float,
+    s: float,
+    el: float,
+    tolerances: np.ndarray,
+    poses: np.ndarray,
+    modes: np.ndarray,
+    errors: np.ndarray,
+    counts: np.ndarray,
+) -> None:
+    """Assembly modes of each solve n from its sextic ``coefficients[n]`` (7,), highest power
+    first: roots (companion eigenvalues, negligible end coefficients trimmed) on the unit circle
+    -> centre from leg circles A and B -> Newton -> IK check -> dedupe -> sort by alpha.
+    Writes ``poses`` (N, 6, 3), ``modes`` (N, 6), ``errors`` (N, 6), ``counts`` (N,);
+    ``tolerances`` = (unit circle, IK verification, duplicate)."""
+    pose = np.empty(3)
+    ax = np.empty(3)
+    ay = np.empty(3)
+    for n in range(coefficients.shape[0]):
+        counts[n] = 0
+        c = coefficients[n]
+        scale = 0.0
+        for k in range(7):
+            scale = max(scale, abs(c[k]))
+        first, last = 0, 6
+        while first < 7 and abs(c[first]) <= 1e-10 * scale:
+            first += 1
+        while last > first and abs(c[last]) <= 1e-10 * scale:
+            last -= 1
+        degree = last - first
+        if degree <= 0:
+            continue
+        companion = np.zeros((degree, degree), dtype=np.complex128)
+        for j in range(degree):
+            companion[0, j] = -c[first + 1 + j] / c[first]
+        for j in range(degree - 1):
+            companion[j + 1, j] = 1.0
+        for z in np.linalg.eigvals(companion):
+            if abs(abs(z) - 1.0) >= tolerances[0]:
+                continue
+            alpha = math.atan2(z.imag, z.real)
+            ca, sa = math.cos(alpha), math.sin(alpha)
+            for i in range(3):
+                ax[i] = elbow[n, i, 0] + rp * (ca * phase[i, 0] - sa * phase[i, 1])
+                ay[i] = elbow[n, i, 1] + rp * (sa * phase[i, 0] + ca * phase[i, 1])
+            # Centre: the intersection of leg circles A and B that lies closest to circle C.
+            chx, chy = ax[1] - ax[0], ay[1] - ay[0]
+            length = max(math.sqrt(chx * chx + chy * chy), 1e-300)
+            half = math.sqrt(max(el * el - 0.25 * length * length, 0.0))
+            best = math.inf
+            for side in (1.0, -1.0):
+                cx = 0.5 * (ax[0] + ax[1]) - side * half * chy / length
+                cy = 0.5 * (ay[0] + ay[1]) + side * half * chx / length
+                miss = abs(math.sqrt((cx - ax[2]) ** 2 + (cy - ay[2]) ** 2) - el)
+                if miss < best:
+                    best = miss
+                    pose[0], pose[1] = cx, cy
+            pose[2] = alpha
+            _closure_newton(elbow[n], pose, phase, rp, el)
+            pose[2] = _wrap(pose[2])
+            error, mode = _verify(pose, theta[n], base, phase, rp, s, el)
+            if not error <= tolerances[1] or counts[n] >= 6:
+                continue
+            duplicate = False
+            for m in range(counts[n]):
+                near = math.hypot(poses[n, m, 0] - pose[0], poses[n, m, 1] - pose[1])
+                if near <= tolerances[2] and abs(_wrap(poses[n, m, 2] - pose[2])) <= tolerances[2]:
+                    duplicate = True
+            if duplicate:
+                continue
+            m = counts[n]  # insertion, sorted by platform angle
+            while m > 0 and poses[n, m - 1, 2] > pose[2]:
+                poses[n, m] = poses[n, m - 1]
+                modes[n, m] = modes[n, m - 1]
+                errors[n, m] = errors[n, m - 1]
+                m -= 1
+            poses[n, m, 0], poses[n, m, 1], poses[n, m, 2] = pose[0], pose[1], pose[2]
+            modes[n, m] = mode
+            errors[n, m] = error
+            counts[n] += 1
 
 
 def solve_fk_batch(
@@ -185,47 +334,40 @@ def solve_fk_batch(
     elbow = elbows(thetas, geometry)
     coefficients = sextic_coefficients(elbow, geometry)
     scale = (geometry.proximal + geometry.distal + geometry.base_circumradius) ** 6
-    roots = _roots(coefficients)
-    owner, alpha = [], []
-    for n, z in enumerate(roots):
-        if np.max(np.abs(coefficients[n])) <= 1e-14 * scale:
-            raise DegenerateForwardKinematicsError(tuple(float(t) for t in thetas[n]))  # type: ignore[arg-type]
-        keep = np.abs(np.abs(z) - 1.0) < PARALLEL_FK_UNIT_CIRCLE_TOLERANCE
-        owner.extend([n] * int(np.sum(keep)))
-        alpha.extend(np.angle(z[keep]))
-    owner_array = np.array(owner, dtype=int)
-    alpha_array = np.array(alpha, dtype=float)
-    results: list[list[tuple[np.ndarray, int, float]]] = [[] for _ in range(thetas.shape[0])]
-    if owner_array.size:
-        centres = _centres(elbow[owner_array], alpha_array, geometry)
-        poses = _newton(elbow[owner_array], np.column_stack([centres, alpha_array]), geometry)
-        poses[:, 2] = np.angle(np.exp(1j * poses[:, 2]))
-        ik = solve_ik_batch(poses, geometry).angles
-        error = np.abs(np.angle(np.exp(1j * (ik - thetas[owner_array][:, None, :])))).max(axis=2)
-        error = np.where(np.isnan(error), np.inf, error)
-        mode = np.argmin(error, axis=1)
-        best = error[np.arange(len(mode)), mode]
-        for k in np.flatnonzero(best <= PARALLEL_FK_VERIFY_TOLERANCE):
-            found = results[owner_array[k]]
-            if all(_distinct(poses[k], other) for other, _, _ in found):
-                found.append((poses[k], int(mode[k]), float(best[k])))
-    return [_result(found) for found in results]
-
-
-def _distinct(a: np.ndarray, b: np.ndarray) -> bool:
-    angle = abs(math.remainder(a[2] - b[2], 2 * math.pi))
-    return bool(
-        np.hypot(*(a[:2] - b[:2])) > PARALLEL_FK_DUPLICATE_TOLERANCE
-        or angle > PARALLEL_FK_DUPLICATE_TOLERANCE
+    degenerate = np.max(np.abs(coefficients), axis=1) <= 1e-14 * scale
+    if np.any(degenerate):
+        bad = thetas[int(np.argmax(degenerate))]
+        raise DegenerateForwardKinematicsError((float(bad[0]), float(bad[1]), float(bad[2])))
+    base, phase = kernel_constants(geometry)
+    count = thetas.shape[0]
+    poses, modes = np.empty((count, 6, 3)), np.empty((count, 6), dtype=np.int64)
+    errors, counts = np.empty((count, 6)), np.empty(count, dtype=np.int64)
+    tolerances = np.array(
+        [
+            PARALLEL_FK_UNIT_CIRCLE_TOLERANCE,
+            PARALLEL_FK_VERIFY_TOLERANCE,
+            PARALLEL_FK_DUPLICATE_TOLERANCE,
+        ]
     )
-
-
-def _result(found: list[tuple[np.ndarray, int, float]]) -> ParallelFKResult:
-    found.sort(key=lambda item: float(item[0][2]))
-    poses = np.array([p for p, _, _ in found]).reshape(-1, 3)
-    return ParallelFKResult(
-        poses, np.array([m for _, m, _ in found], dtype=int), np.array([e for _, _, e in found])
+    fk_kernel(
+        np.ascontiguousarray(coefficients),
+        np.ascontiguousarray(elbow),
+        np.ascontiguousarray(thetas),
+        base,
+        phase,
+        geometry.platform_circumradius,
+        geometry.proximal,
+        geometry.distal,
+        tolerances,
+        poses,
+        modes,
+        errors,
+        counts,
     )
+    return [
+        ParallelFKResult(poses[n, : counts[n]], modes[n, : counts[n]], errors[n, : counts[n]])
+        for n in range(count)
+    ]
 
 
 def solve_fk(theta: np.ndarray, geometry: ParallelGeometry = _DEFAULT_GEOMETRY) -> ParallelFKResult:

@@ -9,8 +9,20 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from lynxplan.exceptions import NoAssemblyModeError, NonFiniteInputError, ShapeError
-from lynxplan.parallel.fk import nearest_assembly_mode, pose_distance, solve_fk, solve_fk_batch
+from lynxplan.exceptions import (
+    DegenerateForwardKinematicsError,
+    NoAssemblyModeError,
+    NonFiniteInputError,
+    ShapeError,
+)
+from lynxplan.parallel.fk import (
+    closure_polynomial,
+    nearest_assembly_mode,
+    pose_distance,
+    sextic_coefficients,
+    solve_fk,
+    solve_fk_batch,
+)
 from lynxplan.parallel.geometry import ParallelGeometry, pose_from_mm_deg
 from lynxplan.parallel.ik import WORKING_MODES, elbows, platform_joints, solve_ik, solve_ik_batch
 
@@ -138,3 +150,29 @@ def test_fk_input_errors() -> None:
         nearest_assembly_mode(np.zeros(3), np.array([0.0, np.nan, 0.0]))
     with pytest.raises(ShapeError, match=r"reference must have shape \(3,\)"):
         nearest_assembly_mode(np.zeros(3), np.zeros(2))
+
+
+def test_sextic_coefficients_reproduce_the_closure_function() -> None:
+    """The degree-3 trigonometric polynomial from 16 samples equals f at arbitrary angles."""
+    rng = np.random.default_rng(11)
+    elbow = elbows(rng.uniform(-math.pi, math.pi, (50, 3)))
+    alpha = rng.uniform(-10, 10, (50, 9))
+    c = sextic_coefficients(elbow, GEOMETRY)  # c[:, 3 - k] multiplies exp(i k alpha)
+    z = np.exp(1j * alpha)
+    series = sum(c[:, 3 - k, None] * z**k for k in range(-3, 4)).real
+    direct = closure_polynomial(elbow, alpha, GEOMETRY.distal, GEOMETRY.platform_circumradius)
+    np.testing.assert_allclose(series, direct, atol=1e-14 * np.abs(direct).max())
+    np.testing.assert_allclose(c[:, ::-1], np.conj(c), atol=1e-15)  # f is real
+
+
+def test_degenerate_mechanism_is_reported() -> None:
+    # Base circumradius = S: all elbows can meet at the base centre; with rp = L the platform
+    # then turns freely about it, so the closure polynomial vanishes identically.
+    geometry = ParallelGeometry(base_circumradius=0.17)
+    towards = geometry.base_centre - geometry.base_joints
+    theta = np.arctan2(towards[:, 1], towards[:, 0])
+    with pytest.raises(
+        DegenerateForwardKinematicsError,
+        match=r"\(30\.0000, 150\.0000, -90\.0000\) deg leave the platform free",
+    ):
+        solve_fk(theta, geometry)
