@@ -15,6 +15,8 @@ from lynxplan import __version__
 from lynxplan.exceptions import LynxplanError
 
 COMMAND_MODULES = (
+    "lynxplan.commands.arm",
+    "lynxplan.commands.workspace",
     "lynxplan.commands.run",
     "lynxplan.commands.bench",
     "lynxplan.commands.parallel",

@@ -137,7 +137,7 @@ def ik_kernel(
     for k in range(T.shape[0]):
         ref = q_ref[k if q_ref.shape[0] > 1 else 0]
         tk = T[k]
-        q_out[k, :, :] = np.nan
+        q_out[k, :, :] = np.nan  # overwritten when solved
         within_out[k, :] = False
         residual_out[k] = np.nan
         miss_out[k] = 0.0
@@ -182,7 +182,7 @@ def ik_kernel(
             o_t[2] = a_t[0] * n_t[1] - a_t[1] * n_t[0]
 
         # Arm plane: radial unit vector towards the tool point (front branch).
-        rho = math.hypot(px, py)
+        rho = math.sqrt(px * px + py * py)
         if rho > BASE_AXIS_TOLERANCE_K:
             c1, s1 = px / rho, py / rho
         else:
@@ -195,7 +195,7 @@ def ik_kernel(
         # Approach projected into the plane: a_s = (c1 s234, s1 s234, -c234).
         s234 = c1 * a_t[0] + s1 * a_t[1]
         c234 = -a_t[2]
-        norm = math.hypot(s234, c234)
+        norm = math.sqrt(s234 * s234 + c234 * c234)
         if norm < 1e-12:  # approach normal to the arm plane: any pitch is as good
             s234, c234 = math.sin(ref[1] + ref[2] + ref[3]), math.cos(ref[1] + ref[2] + ref[3])
         else:
@@ -203,7 +203,7 @@ def ik_kernel(
         # Wrist centre in plane coordinates (radial r, height z).
         r_w = c1 * px + s1 * py - d5 * s234
         z_w = pz + d5 * c234
-        dist = math.hypot(r_w, z_w)
+        dist = math.sqrt(r_w * r_w + z_w * z_w)
         if dist > a2 + a3:
             miss_out[k] = dist - (a2 + a3)
         elif dist < abs(a2 - a3):
@@ -213,23 +213,28 @@ def ik_kernel(
             continue
         c3 = (r_w * r_w + z_w * z_w - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
         c3 = min(1.0, max(-1.0, c3))  # elbow stretched or folded: clamp
-        q3_abs = math.acos(c3)
-        beta = math.atan2(a3 * math.sin(q3_abs), a2 + a3 * c3)
+        s3 = math.sqrt(1.0 - c3 * c3)
+        q3_abs = math.atan2(s3, c3)
+        beta = math.atan2(a3 * s3, a2 + a3 * c3)
+        # Front-branch angles; the back branch (plane direction reversed) follows from identities
+        # instead of more atan2 calls: q1 + pi, q234 -> -q234, phi -> pi - phi, q5 + pi.
+        q1_front = math.atan2(s1, c1)
+        q234_front = math.atan2(s234, c234)
+        phi_front = math.atan2(z_w, r_w)
+        # Roll from n: q5 = atan2(n.y4, n.x4), x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0).
+        n_x4 = n_t[0] * c1 * c234 + n_t[1] * s1 * c234 + n_t[2] * s234
+        n_y4 = n_t[0] * s1 - n_t[1] * c1
+        q5_front = ref[4] if approach_only else math.atan2(n_y4, n_x4)
         for base in range(2):
-            sign = 1.0 if base == 0 else -1.0  # back branch: plane direction reversed
-            cb, sb = sign * c1, sign * s1
-            r_b = sign * r_w
-            phi = math.atan2(z_w, r_b)
-            q1 = math.atan2(sb, cb)
-            q234 = math.atan2(sign * s234, c234)
-            # Roll from n: q5 = atan2(n.y4, n.x4), x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0).
-            x4x, x4y, x4z = cb * c234, sb * c234, sign * s234
-            if approach_only:
-                q5 = ref[4]
+            if base == 0:
+                q1, q234, phi, q5, r_b = q1_front, q234_front, phi_front, q5_front, r_w
             else:
-                q5 = math.atan2(
-                    n_t[0] * sb - n_t[1] * cb, n_t[0] * x4x + n_t[1] * x4y + n_t[2] * x4z
-                )
+                q1 = q1_front - math.pi if q1_front > 0.0 else q1_front + math.pi
+                q234 = -q234_front
+                phi = math.pi - phi_front if phi_front >= 0.0 else -math.pi - phi_front
+                if not approach_only:
+                    q5 = q5_front - math.pi if q5_front > 0.0 else q5_front + math.pi
+                r_b = -r_w
             for elbow in range(2):
                 # Elbow above the shoulder-wrist line: q3 < 0 when the wrist is ahead (r_b >= 0).
                 up = elbow == 0
@@ -239,13 +244,15 @@ def ik_kernel(
                 branch = 2 * base + elbow
                 ok = True
                 for joint, value in enumerate((q1, q2, q3, q4, q5)):
-                    wrapped, inside = _wrap_into_limits(
-                        value, lower[joint], upper[joint], limit_tol
-                    )
-                    q_out[k, branch, joint] = wrapped
-                    ok = ok and inside
+                    lo, hi = lower[joint], upper[joint]
+                    if lo <= value <= hi:
+                        q_out[k, branch, joint] = value
+                    else:
+                        wrapped, inside = _wrap_into_limits(value, lo, hi, limit_tol)
+                        q_out[k, branch, joint] = wrapped
+                        ok = ok and inside
                 within_out[k, branch] = ok
-        # Reached orientation (same for every branch), from the front branch's angles.
+        # Reached orientation (same for every branch, before any snapping onto a limit).
         a_s[0], a_s[1], a_s[2] = c1 * s234, s1 * s234, -c234
         if approach_only:
             dot = _dot3(a_t, a_s)
@@ -254,8 +261,8 @@ def ik_kernel(
             cz = a_t[0] * a_s[1] - a_t[1] * a_s[0]
             residual_out[k] = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), dot)
         else:
-            q5 = q_out[k, 0, 4]
-            c5, s5 = math.cos(q5), math.sin(q5)
+            h = math.sqrt(n_x4 * n_x4 + n_y4 * n_y4)
+            c5, s5 = (n_x4 / h, n_y4 / h) if h > 1e-300 else (1.0, 0.0)
             x4x, x4y, x4z = c1 * c234, s1 * c234, s234
             n_s[0], n_s[1], n_s[2] = c5 * x4x + s5 * s1, c5 * x4y - s5 * c1, c5 * x4z
             o_s[0], o_s[1], o_s[2] = -s5 * x4x + c5 * s1, -s5 * x4y - c5 * c1, -s5 * x4z

@@ -24,10 +24,12 @@ def fk_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -
     for k in range(q.shape[0]):
         s1, c1 = math.sin(q[k, 0]), math.cos(q[k, 0])
         s2, c2 = math.sin(q[k, 1]), math.cos(q[k, 1])
-        s23, c23 = math.sin(q[k, 1] + q[k, 2]), math.cos(q[k, 1] + q[k, 2])
-        q234 = q[k, 1] + q[k, 2] + q[k, 3]
-        s234, c234 = math.sin(q234), math.cos(q234)
+        s3, c3 = math.sin(q[k, 2]), math.cos(q[k, 2])
+        s4, c4 = math.sin(q[k, 3]), math.cos(q[k, 3])
         s5, c5 = math.sin(q[k, 4]), math.cos(q[k, 4])
+        # Angle sums by the addition theorems: 5 sine/cosine pairs instead of 6.
+        s23, c23 = s2 * c3 + c2 * s3, c2 * c3 - s2 * s3
+        s234, c234 = s23 * c4 + c23 * s4, c23 * c4 - s23 * s4
         r = d5 * s234 + a3 * c23 + a2 * c2
         # Frame-4 axes x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0); n = c5 x4 + s5 y4,
         # o = -s5 x4 + c5 y4, a = z4 = (c1 s234, s1 s234, -c234)  (SPEC Part 1, closed form).

@@ -1,10 +1,84 @@
-"""Bench section ``arm``: batch FK/IK throughput, single-pose IK latency, CLIK baseline."""
+"""Bench section ``arm``: batch FK/IK throughput, single-pose IK latency, CLIK baseline.
+
+Everything runs on one core (the numba kernels do not use threads).
+"""
 
 from __future__ import annotations
 
-from lynxplan.bench import Figure
+import time
+
+import numpy as np
+
+from lynxplan.bench import Figure, median_seconds
 
 
 def run(quick: bool) -> list[Figure]:
-    """Measure the arm figures."""
-    return []
+    """Measure the arm figures; ``quick`` uses smaller batches and fewer repeats."""
+    from lynxplan.arm import forward_kinematics, load_arm, solve_ik_batch
+    from lynxplan.arm.clik import solve_clik
+
+    arm = load_arm()
+    rng = np.random.default_rng(0)
+    n = 100_000 if quick else 1_000_000
+    repeats = 3 if quick else 7
+    q = rng.uniform(arm.limits.lower, arm.limits.upper, size=(n, 5))
+    poses = forward_kinematics(q)
+
+    fk_seconds = median_seconds(lambda: forward_kinematics(q), repeats=repeats)
+    ik_seconds = median_seconds(lambda: solve_ik_batch(poses), repeats=repeats)
+    single = poses[0]
+    calls = 2_000 if quick else 20_000
+    single_seconds = median_seconds(lambda: arm.ik(single), repeats=repeats, number=calls)
+
+    clik_count = 20 if quick else 200
+    mid = 0.5 * (arm.limits.lower + arm.limits.upper)
+    start = time.perf_counter()
+    results = [
+        solve_clik(arm.model, arm.data, arm.tool_frame_id, poses[k], mid) for k in range(clik_count)
+    ]
+    clik_seconds = (time.perf_counter() - start) / clik_count
+    success = sum(r.success for r in results) / clik_count
+    per_pose_ik = ik_seconds / n
+
+    return [
+        Figure(
+            "arm",
+            f"batch FK ({n:,} poses)",
+            n / fk_seconds,
+            "poses/s",
+            ">= 1e7",
+            n / fk_seconds >= 1e7,
+        ),
+        Figure(
+            "arm",
+            f"batch IK, 4 branches + limit flags ({n:,} poses)",
+            n / ik_seconds,
+            "poses/s",
+            ">= 3e6",
+            n / ik_seconds >= 3e6,
+        ),
+        Figure(
+            "arm",
+            "single-pose arm.ik (branches, FK check, selection)",
+            single_seconds * 1e6,
+            "us",
+            "<= 20",
+            single_seconds * 1e6 <= 20,
+        ),
+        Figure(
+            "arm",
+            f"CLIK baseline, Pinocchio DLS ({clik_count} targets)",
+            clik_seconds * 1e6,
+            "us/solve",
+        ),
+        Figure("arm", "CLIK baseline success rate", 100.0 * success, "%"),
+        Figure(
+            "arm",
+            "speed-up: CLIK / batch IK per pose",
+            clik_seconds / per_pose_ik,
+            "x",
+            ">= 1000",
+            clik_seconds / per_pose_ik >= 1000,
+        ),
+        Figure("arm", "speed-up: CLIK / single-pose arm.ik", clik_seconds / single_seconds, "x"),
+    ]

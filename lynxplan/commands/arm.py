@@ -1,0 +1,146 @@
+"""``lynxplan fk`` and ``lynxplan ik``: the arm's kinematics from the command line.
+
+JSON output is a contract: other tools parse it. Angles are in the requested angle unit,
+lengths in the requested length unit, orientation errors always in radians.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from typing import Any
+
+import numpy as np
+
+from lynxplan.commands._output import parse_finite, print_json
+from lynxplan.exceptions import InputError, ShapeError
+from lynxplan.units import LENGTH_UNITS, angle_factor, length_factor
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``fk`` and ``ik`` sub-commands."""
+    fk = subparsers.add_parser("fk", help="forward kinematics: joint angles -> tool pose")
+    fk.add_argument(
+        "q", nargs="*", metavar="Q", help="joint angles q1..q5 (rad, or deg with --deg)"
+    )
+    _add_unit_options(fk)
+    fk.set_defaults(handler=handle_fk)
+
+    ik = subparsers.add_parser("ik", help="inverse kinematics: tool pose -> joint angles")
+    ik.add_argument("--pose", required=True, help="tool pose as a JSON 4x4 (or 3x4) nested list")
+    ik.add_argument(
+        "--all", action="store_true", help="list every branch, not only those in limits"
+    )
+    ik.add_argument("--strict", action="store_true", help="fail if the orientation is unreachable")
+    ik.add_argument(
+        "--tolerance", default="1e-6", help="strict orientation tolerance in rad (default 1e-6)"
+    )
+    ik.add_argument(
+        "--select",
+        choices=("nearest", "report"),
+        default="nearest",
+        help="nearest to --reference (default), or the report's rule q2 >= 0, q3 <= 0",
+    )
+    ik.add_argument("--reference", help="reference configuration, JSON list of 5 angles")
+    _add_unit_options(ik)
+    ik.set_defaults(handler=handle_ik)
+
+
+def _add_unit_options(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("--deg", action="store_true", help="angles in degrees (default radians)")
+    parser.add_argument(
+        "--units", choices=tuple(LENGTH_UNITS), default="m", help="length unit (default m)"
+    )
+    parser.add_argument("--json", action="store_true", help="print JSON")
+
+
+def _units(args: argparse.Namespace) -> dict[str, str]:
+    return {"length": args.units, "angle": "deg" if args.deg else "rad"}
+
+
+def handle_fk(args: argparse.Namespace) -> int:
+    """Print the tool pose of the given joint angles."""
+    from lynxplan.arm import load_arm
+
+    units = _units(args)
+    if len(args.q) != 5:
+        raise InputError(f"fk: expected 5 joint angles q1..q5, got {len(args.q)}")
+    q = np.array([parse_finite(text, f"q{i + 1}") for i, text in enumerate(args.q)])
+    T = load_arm().fk(q * angle_factor(units["angle"]))
+    T[:3, 3] /= length_factor(units["length"])
+    if args.json:
+        print_json({"T": T, "units": units})
+    else:
+        print(f"tool pose (lengths in {units['length']}):")
+        for row in T:
+            print("  " + "  ".join(f"{value:12.6f}" for value in row))
+    return 0
+
+
+def parse_pose(text: str, length_unit: str) -> np.ndarray:
+    """JSON 4x4 or 3x4 nested list -> (4, 4) pose in [m]."""
+    try:
+        value = json.loads(text)
+        pose = np.array(value, dtype=float)
+    except (json.JSONDecodeError, TypeError, ValueError) as exc:
+        raise InputError(f"--pose: not a JSON 4x4 list of numbers ({exc})") from None
+    if pose.shape == (3, 4):
+        pose = np.vstack([pose, [0.0, 0.0, 0.0, 1.0]])
+    if pose.shape != (4, 4):
+        raise ShapeError("--pose", "(4, 4) or (3, 4)", pose.shape)
+    pose[:3, 3] *= length_factor(length_unit)
+    return pose
+
+
+def handle_ik(args: argparse.Namespace) -> int:
+    """Print every IK branch of a pose and the selected one."""
+    from lynxplan.arm import load_arm
+
+    units = _units(args)
+    scale = angle_factor(units["angle"])
+    pose = parse_pose(args.pose, units["length"])
+    reference = None
+    if args.reference is not None:
+        try:
+            reference = np.array(json.loads(args.reference), dtype=float) * scale
+        except (json.JSONDecodeError, TypeError, ValueError) as exc:
+            raise InputError(f"--reference: not a JSON list of 5 numbers ({exc})") from None
+    result = load_arm().ik(
+        pose,
+        q_reference=reference,
+        select=args.select,
+        strict=args.strict,
+        orientation_tolerance=parse_finite(args.tolerance, "--tolerance"),
+    )
+    listed = [i for i, s in enumerate(result.solutions) if args.all or s.within_limits]
+    length = length_factor(units["length"])
+    solutions = [
+        {
+            "q": (result.solutions[i].q / scale).tolist(),
+            "branch": result.solutions[i].branch,
+            "within_limits": result.solutions[i].within_limits,
+            "orientation_error": result.solutions[i].orientation_error,
+            "position_error": result.solutions[i].position_error / length,
+        }
+        for i in listed
+    ]
+    selected = listed.index(result.selected) if result.selected in listed else None
+    if args.json:
+        print_json(
+            {
+                "solutions": solutions,
+                "selected": selected,
+                "orientation_residual": result.orientation_residual,
+                "units": {**units, "orientation_error": "rad", "position_error": units["length"]},
+            }
+        )
+        return 0
+    print(f"orientation residual: {result.orientation_residual:.3g} rad")
+    if not solutions:
+        print("no solution within the joint limits (use --all to list every branch)")
+    for k, solution in enumerate(solutions):
+        mark = "*" if k == selected else " "
+        angles = "  ".join(f"{v:10.4f}" for v in solution["q"])
+        flag = "" if solution["within_limits"] else "  (outside limits)"
+        print(f"{mark} {solution['branch']:<17} {angles} {units['angle']}{flag}")
+    return 0

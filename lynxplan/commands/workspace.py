@@ -1,0 +1,58 @@
+"""``lynxplan workspace``: sample the arm's workspace; plots, HTML view and workspace.json."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+from typing import Any
+
+from lynxplan.runner import commit_outputs
+from lynxplan.units import LENGTH_UNITS
+
+
+def register(subparsers: Any) -> None:
+    """Add the ``workspace`` sub-command."""
+    parser = subparsers.add_parser("workspace", help="workspace of the arm: volume, plots, HTML")
+    parser.add_argument("--samples", type=int, default=2_000_000, help="random configurations")
+    parser.add_argument("--out", default="out/workspace", help="output folder")
+    parser.add_argument("--units", choices=tuple(LENGTH_UNITS), default="in", help="length unit")
+    parser.add_argument("--cell", type=float, default=1.0, help="planar grid cell in mm")
+    parser.add_argument("--voxel", type=float, default=10.0, help="voxel edge in mm")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--json", action="store_true", help="print workspace.json to stdout")
+    parser.set_defaults(handler=handle)
+
+
+def handle(args: argparse.Namespace) -> int:
+    """Run the workspace analysis with the command-line settings."""
+    import tempfile
+
+    from lynxplan.arm import workspace_scenario
+    from lynxplan.exceptions import InputError
+    from lynxplan.scenario import Units
+
+    mm_to_unit = 1e-3 / LENGTH_UNITS[args.units]
+    try:
+        scenario = workspace_scenario.Scenario(
+            kind="workspace",
+            samples=args.samples,
+            cell=args.cell * mm_to_unit,
+            voxel_size=args.voxel * mm_to_unit,
+            seed=args.seed,
+            units=Units(length=args.units, angle="deg"),
+        )
+    except ValueError as exc:
+        reason = str(exc).splitlines()[1:3]
+        raise InputError("workspace: " + " ".join(r.strip() for r in reason)) from None
+    out = Path(args.out)
+    out.resolve().parent.mkdir(parents=True, exist_ok=True)
+    with tempfile.TemporaryDirectory(prefix=".workspace-", dir=out.resolve().parent) as staging:
+        outcome = workspace_scenario.run(scenario, Path(staging))
+        summary = (Path(staging) / "workspace.json").read_text(encoding="utf-8")
+        commit_outputs(Path(staging), out)
+    if args.json:
+        print(summary, end="")
+    else:
+        print(outcome.summary)
+        print(f"outputs in {out}/")
+    return 0
