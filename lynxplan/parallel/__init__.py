@@ -6,9 +6,19 @@ Everything inside is SI ([m], [rad]); the CLI and scenario files use the report'
 from lynxplan.parallel.fk import ParallelFKResult, nearest_assembly_mode, solve_fk, solve_fk_batch
 from lynxplan.parallel.geometry import LEG_NAMES, ParallelGeometry, pose_from_mm_deg, pose_to_mm_deg
 from lynxplan.parallel.ik import WORKING_MODES, ParallelIKResult, solve_ik, solve_ik_batch
+from lynxplan.parallel.workspace import (
+    OrientationStack,
+    Workspace,
+    constant_orientation_workspace,
+    orientation_stack,
+)
 
 __all__ = [
     "LEG_NAMES",
+    "OrientationStack",
+    "Workspace",
+    "constant_orientation_workspace",
+    "orientation_stack",
     "WORKING_MODES",
     "ParallelFKResult",
     "ParallelGeometry",

@@ -15,7 +15,7 @@ cross products, ``X + iY = (Nx - A_1x D) + i (Ny - A_1y D)`` only contains the h
 ``z^2, z, 1, z^-1`` of ``z = exp(i alpha)`` and ``D`` is of degree 1, so ``f`` is a real
 trigonometric polynomial of degree 3: ``z^3 f`` is a polynomial of degree 6 in ``z`` — the
 classical sextic of the planar 3-RRR (at most 6 assembly modes). Its coefficients are computed
-exactly (to rounding) by the FFT of 16 samples of ``f``; all six roots are the eigenvalues of the
+exactly (to rounding) by the DFT of 16 samples of ``f``; all six roots are the eigenvalues of the
 companion matrix. Every real solution ``(c, alpha)`` makes ``f(alpha) = 0`` (if ``D(alpha) = 0`` a
 consistent singular system has ``Nx = Ny = 0``, so ``f = 0`` too), hence appears among the roots
 with ``|z| = 1``: nothing is missed. For each such root, ``c`` is recovered by intersecting the

@@ -106,6 +106,9 @@ def plot_workspace(
         zorder=1,
     )
     _draw_base(ax, geometry)
+    region_x = [x_mm[0], x_mm[-1], x_mm[-1], x_mm[0], x_mm[0]]
+    region_y = [y_mm[0], y_mm[0], y_mm[-1], y_mm[-1], y_mm[0]]
+    ax.plot(region_x, region_y, ":", color="0.5", lw=1, label="scanned region")
     if loci_mode is not None:
         angle = np.linspace(0, 2 * math.pi, 721)
         for k, circle in enumerate(type1_circles(workspace.alpha, geometry)):

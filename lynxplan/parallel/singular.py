@@ -106,9 +106,9 @@ def type2_grid_kernel(
     lo, hi = abs(s - el), s + el
     ca, sa = math.cos(alpha), math.sin(alpha)
     scale = el * el * el * rp
+    a = np.empty((3, 3))
     for i in range(y.shape[0]):
         for j in range(x.shape[0]):
-            a = np.empty((3, 3))
             ok = True
             for leg in range(3):
                 cphi = ca * phase[leg, 0] - sa * phase[leg, 1]
