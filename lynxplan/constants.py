@@ -41,3 +41,19 @@ PARALLEL_FK_UNIT_CIRCLE_TOLERANCE = 1e-5
 
 #: Parallel robot: two assembly modes closer than this (in [m] and [rad]) are the same one.
 PARALLEL_FK_DUPLICATE_TOLERANCE = 1e-7
+
+#: Agreement of most (95 %) python-fcl (libccd GJK) distances with coal's for the arm's
+#: primitives, in [m]; the rest are over-estimated by up to millimetres (FCL issue #508).
+FCL_DISTANCE_TOLERANCE = 3e-5
+
+#: Resolved-rate runs: the tool counts as having completed the path once the reference is at its
+#: end and the tool point is within this distance of it, in [m].
+COMPLETION_TOLERANCE = 1e-3
+
+#: Resolved-rate runs stop after this many times the path duration (plus the hold): a
+#: speed-limited run may slow the path down, never without bound.
+RESOLVED_RATE_MAX_TIME_FACTOR = 20.0
+
+#: GJK/EPA tolerance of the coal distance queries (coal's default 1e-6 leaves ~1e-6 m error on
+#: cylinders; this gives ~1e-9 m).
+COAL_GJK_TOLERANCE = 1e-9

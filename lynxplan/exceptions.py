@@ -267,3 +267,38 @@ class CollisionModelError(LynxplanError):
     def __init__(self, geometry: str, reason: str) -> None:
         self.geometry = geometry
         super().__init__(f"collision model, {geometry}: {reason}")
+
+
+class TrajectoryCheckError(InputError):
+    """A trajectory handed to the collision or limit check is malformed (e.g. times not
+    strictly increasing)."""
+
+
+class TaskError(InputError):
+    """A singularity task (selection of tool-Jacobian rows) is unknown or unusable.
+
+    Attributes:
+        task: The task name or row given.
+        reason: What is wrong, with the valid choices.
+    """
+
+    def __init__(self, task: str, reason: str) -> None:
+        self.task = task
+        self.reason = reason
+        super().__init__(f"task {task!r}: {reason}")
+
+
+class SingularityParameterError(InputError):
+    """A parameter of a singularity-handling strategy is out of range.
+
+    Attributes:
+        name: Parameter name, e.g. ``"sigma"``.
+        value: The value given.
+        requirement: What the value must satisfy, e.g. ``"> 0"``.
+    """
+
+    def __init__(self, name: str, value: float, requirement: str) -> None:
+        self.name = name
+        self.value = value
+        self.requirement = requirement
+        super().__init__(f"singularity parameter {name} = {value!r} must be {requirement}")

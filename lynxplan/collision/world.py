@@ -1,0 +1,424 @@
+"""The collision world: the arm's URDF collision primitives and the obstacles, built once.
+
+Every link primitive (box or cylinder of the URDF's ``<collision>`` elements, read through
+Pinocchio's GeometryModel) becomes one collision object when the world is built; a query only
+moves those objects (``setRotation``/``setTranslation``). The obstacles' objects never move.
+
+Two distance engines, both built once:
+
+- ``"coal"`` (default): coal, the FCL fork that ships with Pinocchio. Exact for boxes and
+  cylinders (to ~1e-9 m; checked in the tests against closed forms and dense surface sampling).
+- ``"fcl"``: python-fcl. Its libccd GJK gets box–box distances wrong by millimetres or more (FCL
+  issue #508, still open: two unit cubes 3 m apart along y are reported 3.162 m apart) and
+  box–cylinder ones too: on the arm's links, 95 % of the answers agree with coal to 3e-5 m but
+  some are off by up to 9 mm, always *over*-estimated, the unsafe side for a clearance. It is
+  kept for comparison (tests, bench).
+
+Besides the exact distance, the world offers a cheap, vectorised *lower bound* of every
+link–obstacle distance: each primitive is covered by a few spheres (a box is cut along its longest
+edge, a cylinder along its axis, and each piece is enclosed in its circumscribed sphere), and the
+signed distance of a sphere centre to a box, ball or cylinder has a closed form. Because the
+primitive lies inside the union of its spheres,
+
+    distance(primitive, obstacle) >= min_s (signed_distance(c_s, obstacle) - r_s)
+
+whenever the primitive and the obstacle are apart; a bound <= 0 proves nothing and is always
+followed by an exact query. The collision check uses the bound to skip exact queries whose
+answer cannot matter (branch and bound), never to report a clearance.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from lynxplan.collision import _kernels
+from lynxplan.collision.obstacles import (
+    BoxObstacle,
+    CylinderObstacle,
+    Obstacle,
+    SphereObstacle,
+)
+from lynxplan.constants import COAL_GJK_TOLERANCE
+from lynxplan.exceptions import CollisionModelError, NonFiniteInputError, ShapeError
+
+_AXES = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}
+
+
+@dataclass(frozen=True)
+class LinkPrimitive:
+    """One collision primitive of the arm.
+
+    Attributes:
+        geometry: Name of the geometry object, e.g. ``"gripper_1"``.
+        link: Name of the URDF link carrying it, e.g. ``"gripper"``.
+        joint: Index of the Pinocchio joint that moves it (0: fixed to the base).
+        placement: Pose in the joint frame, shape (4, 4), in [m].
+        kind: ``"box"`` or ``"cylinder"``.
+        half_extents: Box half sizes (3,), or (radius, half length, 0) of a cylinder, in [m].
+        sphere_centres: Covering sphere centres in the primitive frame, shape (K, 3), in [m].
+        sphere_radius: Radius of every covering sphere, in [m].
+        reach: Upper bound of the distance of any point of the primitive from the axis of each
+            joint (shape (nq,), in [m]; 0 for joints that do not move it).
+    """
+
+    geometry: str
+    link: str
+    joint: int
+    placement: np.ndarray
+    kind: str
+    half_extents: np.ndarray
+    sphere_centres: np.ndarray
+    sphere_radius: float
+    reach: np.ndarray
+
+
+class CollisionWorld:
+    """The arm's collision primitives and a set of obstacles, as python-fcl objects built once.
+
+    Args:
+        arm: The arm (``lynxplan.arm.Arm``): its Pinocchio model and collision GeometryModel.
+        obstacles: The obstacles (boxes, spheres, cylinders), in [m].
+        self_collision: Also check every pair of primitives on non-adjacent links.
+        engine: Distance engine, ``"coal"`` (exact) or ``"fcl"`` (python-fcl; see above).
+
+    Attributes:
+        links: The arm's primitives, in GeometryModel order.
+        obstacles: The obstacles.
+        pair_link: Primitive index of each checked pair, shape (P,).
+        pair_other: Obstacle index (or, for self pairs, primitive index) of each pair, (P,).
+        pair_is_self: Whether each pair is a self-collision pair, shape (P,).
+    """
+
+    def __init__(
+        self,
+        arm: Any,
+        obstacles: tuple[Obstacle, ...] | list[Obstacle] = (),
+        *,
+        self_collision: bool = False,
+        engine: str = "coal",
+    ) -> None:
+        import coal
+        import fcl
+
+        if engine not in ("coal", "fcl"):
+            raise CollisionModelError("engine", f"engine must be 'coal' or 'fcl'. Got: {engine!r}")
+        self.engine = engine
+
+        self.model = arm.model
+        self.obstacles: tuple[Obstacle, ...] = tuple(obstacles)
+        names = [o.name for o in self.obstacles]
+        if len(set(names)) != len(names):
+            raise CollisionModelError("obstacles", f"obstacle names must be unique. Got: {names}")
+        self._joint_axes, self._joint_placements = _joint_structure(self.model)
+        self.links: tuple[LinkPrimitive, ...] = tuple(
+            _primitive(self.model, g, self._joint_placements)
+            for g in arm.collision_model.geometryObjects
+        )
+        self._link_objects = [
+            fcl.CollisionObject(_fcl_shape(p), fcl.Transform()) for p in self.links
+        ]
+        self._obstacle_objects = [
+            fcl.CollisionObject(o.fcl_geometry(), fcl.Transform(np.asarray(o.rotation), o.centre))
+            for o in self.obstacles
+        ]
+        pairs = [(g, o, False) for o in range(len(self.obstacles)) for g in range(len(self.links))]
+        if self_collision:
+            parents = list(self.model.parents)
+            for a in range(len(self.links)):
+                for b in range(a + 1, len(self.links)):
+                    ja, jb = self.links[a].joint, self.links[b].joint
+                    if ja != jb and parents[ja] != jb and parents[jb] != ja:
+                        pairs.append((a, b, True))
+        self.pair_link = np.array([p[0] for p in pairs], dtype=np.intp)
+        self.pair_other = np.array([p[1] for p in pairs], dtype=np.intp)
+        self.pair_is_self = np.array([p[2] for p in pairs], dtype=bool)
+        for array in (self.pair_link, self.pair_other, self.pair_is_self):
+            array.setflags(write=False)
+        self._request = fcl.DistanceRequest(enable_signed_distance=True)
+        shapes = [g.geometry for g in arm.collision_model.geometryObjects]
+        self._coal_link_poses = [coal.Transform3s() for _ in self.links]
+        self._coal_obstacle_poses = [
+            coal.Transform3s(np.asarray(o.rotation), o.centre) for o in self.obstacles
+        ]
+        obstacle_shapes = [o.coal_geometry() for o in self.obstacles]
+        # The ComputeDistance functors hold raw pointers: keep the shapes alive with the world.
+        self._coal_shapes = (shapes, obstacle_shapes)
+        self._coal_pairs = [
+            coal.ComputeDistance(shapes[a], shapes[b] if is_self else obstacle_shapes[b])
+            for a, b, is_self in pairs
+        ]
+        self._coal_request = coal.DistanceRequest()
+        # coal's default GJK tolerance (1e-6) leaves ~1e-6 m on curved shapes (cylinders).
+        self._coal_request.gjk_tolerance = COAL_GJK_TOLERANCE
+        self._coal_request.epa_tolerance = COAL_GJK_TOLERANCE
+        self._coal_result_type = coal.DistanceResult
+        self._sphere_owner = np.concatenate(
+            [np.full(len(p.sphere_centres), i) for i, p in enumerate(self.links)]
+        )
+        self._sphere_starts = np.searchsorted(self._sphere_owner, np.arange(len(self.links)))
+        self._sphere_radius = np.array([p.sphere_radius for p in self.links])
+        self._sphere_local = np.concatenate(
+            [np.hstack((p.sphere_centres, np.ones((len(p.sphere_centres), 1)))) for p in self.links]
+        )
+        self._primitive_placements = np.stack([p.placement for p in self.links])
+        self._primitive_joints = np.array([p.joint for p in self.links], dtype=np.intp)
+        self._reach = np.stack([p.reach for p in self.links])
+        self._kernel_joints = (
+            np.array([a for a, _ in self._joint_axes], dtype=np.int64),
+            np.array([i for _, i in self._joint_axes], dtype=np.int64),
+            np.array(self.model.parents, dtype=np.int64),
+            np.stack(self._joint_placements),
+            self._primitive_joints.astype(np.int64),
+            self._primitive_placements,
+        )
+        self._kernel_obstacles = _obstacle_arrays(self.obstacles)
+
+    # -- names --------------------------------------------------------------------------------
+    @property
+    def pair_count(self) -> int:
+        """Number of checked pairs P."""
+        return len(self.pair_link)
+
+    def pair_names(self, pair: int) -> tuple[str, str, str]:
+        """(link, geometry, obstacle) names of a pair; a self pair's obstacle is ``self:<geom>``."""
+        link = self.links[int(self.pair_link[pair])]
+        other = int(self.pair_other[pair])
+        if self.pair_is_self[pair]:
+            return link.link, link.geometry, f"self:{self.links[other].geometry}"
+        return link.link, link.geometry, self.obstacles[other].name
+
+    # -- kinematics ---------------------------------------------------------------------------
+    def primitive_poses(self, q: Any) -> np.ndarray:
+        """World poses of every primitive. q: (nq,) or (N, nq) in [rad] -> (N, G, 4, 4), [m]."""
+        config = _configurations(q, self.model.nq)
+        poses = np.empty((len(config), len(self.links), 4, 4))
+        _kernels.poses_kernel(config, *self._kernel_joints, poses)
+        return poses
+
+    # -- distances ----------------------------------------------------------------------------
+    def lower_bounds(self, poses: np.ndarray) -> np.ndarray:
+        """Lower bounds of every pair's distance. poses: (N, G, 4, 4) -> (N, P), in [m].
+
+        A positive bound is a proven lower bound of the distance; a bound <= 0 proves nothing.
+        """
+        bounds = np.empty((poses.shape[0], self.pair_count))
+        obstacle_pairs = ~self.pair_is_self
+        if obstacle_pairs.any():
+            per_link = np.empty((poses.shape[0], len(self.links), len(self.obstacles)))
+            kinds, centres, rotations, sizes = self._kernel_obstacles
+            _kernels.obstacle_bounds_kernel(
+                np.ascontiguousarray(poses),
+                self._sphere_owner,
+                self._sphere_local[:, :3].copy(),
+                self._sphere_radius,
+                kinds,
+                centres,
+                rotations,
+                sizes,
+                per_link,
+            )
+            bounds[:, obstacle_pairs] = per_link[
+                :, self.pair_link[obstacle_pairs], self.pair_other[obstacle_pairs]
+            ]
+        self_pairs = np.flatnonzero(self.pair_is_self)
+        if self_pairs.size:
+            centres = np.einsum(
+                "ngij,gj->ngi", poses[:, self._sphere_owner, :3, :], self._sphere_local
+            )  # (N, S, 3)
+        for p in self_pairs:
+            a, b = int(self.pair_link[p]), int(self.pair_other[p])
+            sa = slice(
+                self._sphere_starts[a], self._sphere_starts[a] + len(self.links[a].sphere_centres)
+            )
+            sb = slice(
+                self._sphere_starts[b], self._sphere_starts[b] + len(self.links[b].sphere_centres)
+            )
+            gaps = np.linalg.norm(centres[:, sa, None, :] - centres[:, None, sb, :], axis=-1)
+            bounds[:, p] = gaps.min(axis=(1, 2)) - self._sphere_radius[a] - self._sphere_radius[b]
+        return bounds
+
+    def distance(self, poses: np.ndarray, pair: int) -> float:
+        """Signed distance of one pair, in [m]; negative: minus the penetration depth.
+
+        poses: Primitive poses of one configuration, shape (G, 4, 4), in [m].
+        """
+        if self.engine == "coal":
+            return self._coal_distance(poses, pair)
+        return self._fcl_distance(poses, pair)
+
+    def _coal_distance(self, poses: np.ndarray, pair: int) -> float:
+        a = int(self.pair_link[pair])
+        first = self._coal_link_poses[a]
+        first.setRotation(poses[a, :3, :3])
+        first.setTranslation(poses[a, :3, 3])
+        if self.pair_is_self[pair]:
+            b = int(self.pair_other[pair])
+            second = self._coal_link_poses[b]
+            second.setRotation(poses[b, :3, :3])
+            second.setTranslation(poses[b, :3, 3])
+        else:
+            second = self._coal_obstacle_poses[int(self.pair_other[pair])]
+        # A DistanceResult keeps the minimum over calls: a fresh one per query.
+        result = self._coal_result_type()
+        return float(self._coal_pairs[pair](first, second, self._coal_request, result))
+
+    def _fcl_distance(self, poses: np.ndarray, pair: int) -> float:
+        import fcl
+
+        a = int(self.pair_link[pair])
+        first = self._link_objects[a]
+        first.setRotation(poses[a, :3, :3])
+        first.setTranslation(poses[a, :3, 3])
+        if self.pair_is_self[pair]:
+            b = int(self.pair_other[pair])
+            second = self._link_objects[b]
+            second.setRotation(poses[b, :3, :3])
+            second.setTranslation(poses[b, :3, 3])
+        else:
+            second = self._obstacle_objects[int(self.pair_other[pair])]
+        return float(fcl.distance(first, second, self._request))
+
+    def distances(self, q: Any) -> np.ndarray:
+        """Signed distance of every pair at every configuration: (N, nq) -> (N, P), in [m]."""
+        poses = self.primitive_poses(q)
+        return np.array(
+            [
+                [self.distance(poses[n], p) for p in range(self.pair_count)]
+                for n in range(len(poses))
+            ]
+        ).reshape(len(poses), self.pair_count)
+
+    def motion_bounds(self, q: np.ndarray) -> np.ndarray:
+        """Largest displacement of any point of each pair's moving geometry between samples.
+
+        With joints moving monotonically from ``q[k]`` to ``q[k+1]`` (e.g. linearly), no point of
+        primitive g moves farther than ``sum_j reach[g, j] * |q[k+1, j] - q[k, j]|`` from where it
+        was at either sample (see :mod:`lynxplan.collision.check`). For a self pair both
+        primitives move, and the sum of both bounds applies.
+
+        q: shape (N, nq), in [rad] -> shape (N - 1, P), in [m].
+        """
+        per_link = np.abs(np.diff(q, axis=0)) @ self._reach.T  # (N - 1, G)
+        bounds = per_link[:, self.pair_link]
+        if self.pair_is_self.any():
+            bounds[:, self.pair_is_self] += per_link[:, self.pair_other[self.pair_is_self]]
+        return bounds
+
+
+def _configurations(q: Any, nq: int) -> np.ndarray:
+    config = np.asarray(q, dtype=float)
+    if config.ndim == 1:
+        config = config[None, :]
+    if config.ndim != 2 or config.shape[1] != nq:
+        raise ShapeError("q", f"({nq},) or (N, {nq})", np.shape(q))
+    if not np.isfinite(config).all():
+        raise NonFiniteInputError("q")
+    return config
+
+
+def _joint_structure(model: Any) -> tuple[list[tuple[int, int]], list[np.ndarray]]:
+    axes: list[tuple[int, int]] = [(-1, -1)]
+    for j in range(1, model.njoints):
+        joint = model.joints[j]
+        if joint.shortname() not in _AXES:
+            raise CollisionModelError(
+                model.names[j], f"joint type {joint.shortname()} is not supported (revolute x/y/z)"
+            )
+        axes.append((_AXES[joint.shortname()], joint.idx_q))
+    placements = [np.array(model.jointPlacements[j].homogeneous) for j in range(model.njoints)]
+    return axes, placements
+
+
+def _primitive(
+    model: Any, geometry_object: Any, joint_placements: list[np.ndarray]
+) -> LinkPrimitive:
+    shape = geometry_object.geometry
+    kind = type(shape).__name__
+    name = geometry_object.name
+    if kind == "Box":
+        half = np.array(shape.halfSide, dtype=float)
+        longest = int(np.argmax(half))
+        second = float(np.sort(half)[-2])
+        pieces = max(1, math.ceil(half[longest] / second))
+        bounding = float(np.linalg.norm(half))
+    elif kind == "Cylinder":
+        half = np.array([shape.radius, shape.halfLength, 0.0])
+        longest = 2
+        pieces = max(1, math.ceil(shape.halfLength / shape.radius))
+        bounding = math.hypot(shape.radius, shape.halfLength)
+    else:
+        raise CollisionModelError(name, f"shape {kind} is not supported (box or cylinder)")
+    length = half[longest] if kind == "Box" else shape.halfLength
+    piece_half = length / pieces
+    centres = np.zeros((pieces, 3))
+    centres[:, longest] = -length + piece_half * (2 * np.arange(pieces) + 1)
+    if kind == "Box":
+        sub = half.copy()
+        sub[longest] = piece_half
+        radius = float(np.linalg.norm(sub))
+    else:
+        radius = math.hypot(shape.radius, piece_half)
+    placement = np.array(geometry_object.placement.homogeneous)
+    joint = int(geometry_object.parentJoint)
+    reach = np.zeros(model.nq)
+    # Distance of any point of the primitive from joint j's origin (on its axis), bounded by the
+    # chain of joint offsets from j down to the primitive's joint plus the primitive's extent.
+    chain = float(np.linalg.norm(placement[:3, 3])) + bounding
+    current = joint
+    while current > 0:
+        reach[model.joints[current].idx_q] = chain
+        chain += float(np.linalg.norm(joint_placements[current][:3, 3]))
+        current = model.parents[current]
+    for array in (placement, half, centres, reach):
+        array.setflags(write=False)
+    link = model.frames[geometry_object.parentFrame].name
+    return LinkPrimitive(name, link, joint, placement, kind.lower(), half, centres, radius, reach)
+
+
+def _fcl_shape(primitive: LinkPrimitive) -> Any:
+    import fcl
+
+    if primitive.kind == "box":
+        return fcl.Box(*(2.0 * primitive.half_extents).tolist())
+    radius, half_length, _ = primitive.half_extents.tolist()
+    return fcl.Cylinder(radius, 2.0 * half_length)
+
+
+def _obstacle_arrays(obstacles: tuple[Obstacle, ...]) -> tuple[np.ndarray, ...]:
+    """Obstacle kinds, centres (O, 3), rotations (O, 3, 3), half sizes (O, 3) for the kernels."""
+    kinds = np.zeros(len(obstacles), dtype=np.int64)
+    sizes = np.zeros((len(obstacles), 3))
+    for o, obstacle in enumerate(obstacles):
+        if isinstance(obstacle, BoxObstacle):
+            kinds[o], sizes[o] = _kernels.BOX, obstacle.size / 2.0
+        elif isinstance(obstacle, SphereObstacle):
+            kinds[o], sizes[o, 0] = _kernels.SPHERE, obstacle.radius
+        else:
+            kinds[o] = _kernels.CYLINDER
+            sizes[o, :2] = obstacle.radius, obstacle.length / 2.0
+    centres = np.array([o.centre for o in obstacles]).reshape(-1, 3)
+    rotations = np.array([np.asarray(o.rotation) for o in obstacles]).reshape(-1, 3, 3)
+    return kinds, centres, rotations, sizes
+
+
+def signed_distance(obstacle: Obstacle, points: np.ndarray) -> np.ndarray:
+    """Exact signed distance of points (..., 3) to an obstacle, in [m] (negative inside)."""
+    local = (points - obstacle.centre) @ np.asarray(obstacle.rotation)
+    if isinstance(obstacle, SphereObstacle):
+        return np.linalg.norm(local, axis=-1) - obstacle.radius
+    if isinstance(obstacle, BoxObstacle):
+        excess = np.abs(local) - obstacle.size / 2.0
+    elif isinstance(obstacle, CylinderObstacle):
+        excess = np.stack(
+            (
+                np.linalg.norm(local[..., :2], axis=-1) - obstacle.radius,
+                np.abs(local[..., 2]) - obstacle.length / 2.0,
+            ),
+            axis=-1,
+        )
+    outside = np.linalg.norm(np.maximum(excess, 0.0), axis=-1)
+    return outside + np.minimum(excess.max(axis=-1), 0.0)
