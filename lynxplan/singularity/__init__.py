@@ -1,0 +1,43 @@
+"""Singularities of the 5-DOF arm: measures, classification, resolved-rate strategies (Part 5)."""
+
+from lynxplan.singularity.measures import (
+    NAMED_TASKS,
+    ROW_NAMES,
+    Singularity,
+    SingularityDistance,
+    Task,
+    condition_number,
+    extended_jacobian,
+    make_task,
+    manipulability,
+    manipulability_and_gradient,
+    manipulability_gradient,
+    near_singularities,
+    nearest_singularity,
+    singular_conditions,
+    singular_values,
+    singularity_distances,
+    task_jacobian,
+    task_jacobian_derivative,
+)
+
+__all__ = [
+    "NAMED_TASKS",
+    "ROW_NAMES",
+    "Singularity",
+    "SingularityDistance",
+    "Task",
+    "condition_number",
+    "extended_jacobian",
+    "make_task",
+    "manipulability",
+    "manipulability_and_gradient",
+    "manipulability_gradient",
+    "near_singularities",
+    "nearest_singularity",
+    "singular_conditions",
+    "singular_values",
+    "singularity_distances",
+    "task_jacobian",
+    "task_jacobian_derivative",
+]
