@@ -7,7 +7,7 @@ moves those objects (``setRotation``/``setTranslation``). The obstacles' objects
 Two distance engines, both built once:
 
 - ``"coal"`` (default): coal, the FCL fork that ships with Pinocchio. Exact for boxes and
-  cylinders (to ~1e-9 m; checked in the tests against closed forms and dense surface sampling).
+  cylinders (to ~1e-9 m with the tolerance set here; checked in the tests against closed forms).
 - ``"fcl"``: python-fcl. Its libccd GJK gets box–box distances wrong by millimetres or more (FCL
   issue #508, still open: two unit cubes 3 m apart along y are reported 3.162 m apart) and
   box–cylinder ones too: on the arm's links, 95 % of the answers agree with coal to 3e-5 m but
