@@ -52,7 +52,7 @@ class WritingPlane:
 
 
 def tilted_plane(
-    point: Sequence[float], tilt_deg: float = 20.0, size: tuple[float, float] = (0.3, 0.3)
+    point: Any, tilt_deg: float = 20.0, size: tuple[float, float] = (0.3, 0.3)
 ) -> WritingPlane:
     """A plane through ``point`` (3,) [m] tilted by ``tilt_deg`` [deg] to x-y, rising along +y."""
     tilt = np.radians(tilt_deg)
