@@ -20,6 +20,7 @@ from lynxplan.exceptions import ScenarioError
 #: Scenario kind -> module that defines ``Scenario`` (pydantic model) and ``run``.
 KIND_MODULES: dict[str, str] = {
     "workspace": "lynxplan.arm.workspace_scenario",
+    "singularity": "lynxplan.singularity.scenario",
     "parallel_ik": "lynxplan.parallel.ik_scenario",
     "parallel_workspace": "lynxplan.parallel.workspace_scenario",
     "trajectory": "lynxplan.trajectory.scenario",
