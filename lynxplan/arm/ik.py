@@ -21,6 +21,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._fastmath import atan2, sincos
 from lynxplan.arm.geometry import ArmGeometry, JointLimits
 from lynxplan.arm.kinematics import fk_kernel
 from lynxplan.constants import (
@@ -77,7 +78,8 @@ class IkBatch(NamedTuple):
 @numba.njit(cache=True, nogil=True, inline="always")
 def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
-    y = lo + (x - lo) % TWO_PI  # y in [lo, lo + 2 pi)
+    turns = math.floor((x - lo) / TWO_PI)  # floor is one instruction; % calls fmod
+    y = x - turns * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
     if y <= hi:
         return y, True
     if y <= hi + tol:
@@ -88,7 +90,7 @@ def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float
     return (y, False) if above <= below else (y - TWO_PI, False)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _angle_between_frames(
     n_t: np.ndarray,
     o_t: np.ndarray,
@@ -103,7 +105,7 @@ def _angle_between_frames(
     m02, m20 = _dot3(n_t, a_s), _dot3(a_t, n_s)
     m12, m21 = _dot3(o_t, a_s), _dot3(a_t, o_s)
     sx, sy, sz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
-    return math.atan2(math.sqrt(sx * sx + sy * sy + sz * sz), 0.5 * (m00 + m11 + m22 - 1.0))
+    return atan2(math.sqrt(sx * sx + sy * sy + sz * sz), 0.5 * (m00 + m11 + m22 - 1.0))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -135,31 +137,35 @@ def ik_kernel(
     o_s = np.empty(3)
     a_s = np.empty(3)
     for k in range(T.shape[0]):
-        ref = q_ref[k if q_ref.shape[0] > 1 else 0]
-        tk = T[k]
-        q_out[k, :, :] = np.nan  # overwritten when solved
-        within_out[k, :] = False
+        # Plain indices, no per-pose views: a view costs reference-count updates in numba.
+        r_k = k if q_ref.shape[0] > 1 else 0
+        for b in range(4):  # overwritten when solved (loops, not slices: no views)
+            within_out[k, b] = False
+            for j in range(5):
+                q_out[k, b, j] = np.nan
         residual_out[k] = np.nan
         miss_out[k] = 0.0
         deviation_out[k] = 0.0
         finite = True
         for i in range(4):
             for j in range(4):
-                if not math.isfinite(tk[i, j]):
+                if not math.isfinite(T[k, i, j]):
                     finite = False
         if not finite:
             status_out[k] = IkStatus.NON_FINITE
             continue
-        px, py, pz = tk[0, 3], tk[1, 3], tk[2, 3]
+        px, py, pz = T[k, 0, 3], T[k, 1, 3], T[k, 2, 3]
         for i in range(3):
-            a_t[i] = tk[i, 2]
-            n_t[i] = tk[i, 0]
+            a_t[i] = T[k, i, 2]
+            n_t[i] = T[k, i, 0]
         # Rigidity: max |R^T R - I| and the bottom row; repair by Gram-Schmidt from the approach.
-        dev = max(abs(tk[3, 0]), abs(tk[3, 1]), abs(tk[3, 2]), abs(tk[3, 3] - 1.0))
+        dev = max(abs(T[k, 3, 0]), abs(T[k, 3, 1]), abs(T[k, 3, 2]), abs(T[k, 3, 3] - 1.0))
         if not approach_only:
             for i in range(3):
                 for j in range(3):
-                    dot = tk[0, i] * tk[0, j] + tk[1, i] * tk[1, j] + tk[2, i] * tk[2, j]
+                    dot = (
+                        T[k, 0, i] * T[k, 0, j] + T[k, 1, i] * T[k, 1, j] + T[k, 2, i] * T[k, 2, j]
+                    )
                     dev = max(dev, abs(dot - (1.0 if i == j else 0.0)))
         else:
             dev = max(dev, abs(math.sqrt(_dot3(a_t, a_t)) - 1.0))
@@ -191,13 +197,13 @@ def ik_kernel(
             if horizontal > 1e-9:
                 c1, s1 = a_t[0] / horizontal, a_t[1] / horizontal
             else:
-                c1, s1 = math.cos(ref[0]), math.sin(ref[0])
+                c1, s1 = math.cos(q_ref[r_k, 0]), math.sin(q_ref[r_k, 0])
         # Approach projected into the plane: a_s = (c1 s234, s1 s234, -c234).
         s234 = c1 * a_t[0] + s1 * a_t[1]
         c234 = -a_t[2]
         norm = math.sqrt(s234 * s234 + c234 * c234)
         if norm < 1e-12:  # approach normal to the arm plane: any pitch is as good
-            s234, c234 = math.sin(ref[1] + ref[2] + ref[3]), math.cos(ref[1] + ref[2] + ref[3])
+            s234, c234 = sincos(q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3])
         else:
             s234, c234 = s234 / norm, c234 / norm
         # Wrist centre in plane coordinates (radial r, height z).
@@ -214,17 +220,17 @@ def ik_kernel(
         c3 = (r_w * r_w + z_w * z_w - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
         c3 = min(1.0, max(-1.0, c3))  # elbow stretched or folded: clamp
         s3 = math.sqrt(1.0 - c3 * c3)
-        q3_abs = math.atan2(s3, c3)
-        beta = math.atan2(a3 * s3, a2 + a3 * c3)
+        q3_abs = atan2(s3, c3)
+        beta = atan2(a3 * s3, a2 + a3 * c3)
         # Front-branch angles; the back branch (plane direction reversed) follows from identities
         # instead of more atan2 calls: q1 + pi, q234 -> -q234, phi -> pi - phi, q5 + pi.
-        q1_front = math.atan2(s1, c1)
-        q234_front = math.atan2(s234, c234)
-        phi_front = math.atan2(z_w, r_w)
+        q1_front = atan2(s1, c1)
+        q234_front = atan2(s234, c234)
+        phi_front = atan2(z_w, r_w)
         # Roll from n: q5 = atan2(n.y4, n.x4), x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0).
         n_x4 = n_t[0] * c1 * c234 + n_t[1] * s1 * c234 + n_t[2] * s234
         n_y4 = n_t[0] * s1 - n_t[1] * c1
-        q5_front = ref[4] if approach_only else math.atan2(n_y4, n_x4)
+        q5_front = q_ref[r_k, 4] if approach_only else atan2(n_y4, n_x4)
         for base in range(2):
             if base == 0:
                 q1, q234, phi, q5, r_b = q1_front, q234_front, phi_front, q5_front, r_w
@@ -259,7 +265,7 @@ def ik_kernel(
             cx = a_t[1] * a_s[2] - a_t[2] * a_s[1]
             cy = a_t[2] * a_s[0] - a_t[0] * a_s[2]
             cz = a_t[0] * a_s[1] - a_t[1] * a_s[0]
-            residual_out[k] = math.atan2(math.sqrt(cx * cx + cy * cy + cz * cz), dot)
+            residual_out[k] = atan2(math.sqrt(cx * cx + cy * cy + cz * cz), dot)
         else:
             h = math.sqrt(n_x4 * n_x4 + n_y4 * n_y4)
             c5, s5 = (n_x4 / h, n_y4 / h) if h > 1e-300 else (1.0, 0.0)

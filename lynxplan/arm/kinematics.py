@@ -7,11 +7,10 @@ numba and loop over a batch on one core; the public functions accept one configu
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
+from lynxplan._fastmath import sincos
 from lynxplan.arm.geometry import ArmGeometry
 from lynxplan.exceptions import NonFiniteInputError, ShapeError
 
@@ -22,11 +21,11 @@ _DEFAULT_GEOMETRY = ArmGeometry()
 def fk_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -> None:
     """Write the tool transforms of the configurations ``q`` (N, 5) into ``out`` (N, 4, 4)."""
     for k in range(q.shape[0]):
-        s1, c1 = math.sin(q[k, 0]), math.cos(q[k, 0])
-        s2, c2 = math.sin(q[k, 1]), math.cos(q[k, 1])
-        s3, c3 = math.sin(q[k, 2]), math.cos(q[k, 2])
-        s4, c4 = math.sin(q[k, 3]), math.cos(q[k, 3])
-        s5, c5 = math.sin(q[k, 4]), math.cos(q[k, 4])
+        s1, c1 = sincos(q[k, 0])
+        s2, c2 = sincos(q[k, 1])
+        s3, c3 = sincos(q[k, 2])
+        s4, c4 = sincos(q[k, 3])
+        s5, c5 = sincos(q[k, 4])
         # Angle sums by the addition theorems: 5 sine/cosine pairs instead of 6.
         s23, c23 = s2 * c3 + c2 * s3, c2 * c3 - s2 * s3
         s234, c234 = s23 * c4 + c23 * s4, c23 * c4 - s23 * s4
@@ -60,11 +59,11 @@ def jacobian_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndar
     [m/s], rows 3-5 to the angular velocity in [rad/s], both in base-frame axes.
     """
     for k in range(q.shape[0]):
-        s1, c1 = math.sin(q[k, 0]), math.cos(q[k, 0])
-        s2, c2 = math.sin(q[k, 1]), math.cos(q[k, 1])
-        s23, c23 = math.sin(q[k, 1] + q[k, 2]), math.cos(q[k, 1] + q[k, 2])
+        s1, c1 = sincos(q[k, 0])
+        s2, c2 = sincos(q[k, 1])
+        s23, c23 = sincos(q[k, 1] + q[k, 2])
         q234 = q[k, 1] + q[k, 2] + q[k, 3]
-        s234, c234 = math.sin(q234), math.cos(q234)
+        s234, c234 = sincos(q234)
         # Column i: z_{i-1} x (p - o_{i-1}) and z_{i-1}. z0 = (0,0,1); z1 = z2 = z3 = (s1,-c1,0);
         # z4 = approach axis. Distances in the arm plane: radial r_i and height h_i of p - o_i.
         r_tool = d5 * s234 + a3 * c23 + a2 * c2
@@ -98,18 +97,26 @@ def as_configurations(
     return np.ascontiguousarray(array.reshape(-1, 5))
 
 
-def forward_kinematics(q: np.ndarray, geometry: ArmGeometry = _DEFAULT_GEOMETRY) -> np.ndarray:
+def forward_kinematics(
+    q: np.ndarray, geometry: ArmGeometry = _DEFAULT_GEOMETRY, *, out: np.ndarray | None = None
+) -> np.ndarray:
     """Tool (pen tip) pose in the base frame.
 
     Args:
         q: Joint angles, shape (5,) or (N, 5), in [rad].
         geometry: Arm dimensions.
+        out: Optional C-contiguous float array of shape (N, 4, 4) to write into (saves the
+            allocation in tight loops over large batches).
 
     Returns:
         Homogeneous transforms, shape (4, 4) or (N, 4, 4), translations in [m].
     """
     batch = as_configurations(q)
-    out = np.empty((batch.shape[0], 4, 4))
+    shape = (batch.shape[0], 4, 4)
+    if out is None:
+        out = np.empty(shape)
+    elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
+        raise ShapeError("out", f"{shape}, float64, C-contiguous", out.shape)
     fk_kernel(batch, geometry.a2, geometry.a3, geometry.d5, out)
     return out[0] if np.ndim(q) == 1 else out
 

@@ -116,3 +116,12 @@ def test_wrong_shape_is_rejected(bad: np.ndarray) -> None:
 def test_nan_is_rejected() -> None:
     with pytest.raises(NonFiniteInputError, match="q contains NaN"):
         tool_jacobian(np.array([0, np.nan, 0, 0, 0]))
+
+
+def test_fk_into_preallocated_output() -> None:
+    q = np.random.default_rng(9).uniform(-3, 3, size=(7, 5))
+    out = np.empty((7, 4, 4))
+    assert forward_kinematics(q, out=out) is out
+    np.testing.assert_array_equal(out, forward_kinematics(q))
+    with pytest.raises(ShapeError, match="out must have shape"):
+        forward_kinematics(q, out=np.empty((6, 4, 4)))
