@@ -20,6 +20,7 @@ COMMAND_MODULES = (
     "lynxplan.commands.run",
     "lynxplan.commands.bench",
     "lynxplan.commands.parallel",
+    "lynxplan.commands.scenario_tools",
 )
 
 

@@ -24,6 +24,7 @@ KIND_MODULES: dict[str, str] = {
     "parallel_ik": "lynxplan.parallel.ik_scenario",
     "parallel_workspace": "lynxplan.parallel.workspace_scenario",
     "trajectory": "lynxplan.trajectory.scenario",
+    "task": "lynxplan.task.run",
 }
 
 

@@ -1,0 +1,337 @@
+"""A validated task scenario resolved into SI values: robot, obstacles, waypoint angles, the plan.
+
+Every problem found here is raised as a pydantic ``ValidationError`` located at its key path
+(``segments[3].to``, ``waypoints.O2.pose``), so the scenario loader reports it exactly like a
+schema error: file, key path, reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+from pydantic import ValidationError
+from pydantic_core import InitErrorDetails, PydanticCustomError
+
+from lynxplan.constants import LIMIT_SNAP_TOLERANCE
+from lynxplan.exceptions import LynxplanError
+from lynxplan.units import angle_factor, length_factor
+
+if TYPE_CHECKING:
+    from lynxplan.arm.model import Arm
+    from lynxplan.collision.obstacles import Obstacle
+    from lynxplan.task.schema import (
+        BoxEntry,
+        CylinderEntry,
+        RobotEntry,
+        Scenario,
+        SphereEntry,
+        WaypointEntry,
+    )
+    from lynxplan.trajectory.limits import MotionLimits
+    from lynxplan.trajectory.plan import Plan
+
+
+@dataclass(frozen=True)
+class WritingPlane:
+    """The writing surface (drawn only).
+
+    Attributes:
+        point: A point of the plane, shape (3,), in [m].
+        tilt: Angle to the x-y plane, rising along +y, in [rad].
+        size: Extent along x and along the rising direction, shape (2,), in [m].
+    """
+
+    point: np.ndarray
+    tilt: float
+    size: np.ndarray
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """Plane axes (columns: x, rising direction, normal), shape (3, 3)."""
+        c, s = np.cos(self.tilt), np.sin(self.tilt)
+        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+
+
+@dataclass(frozen=True)
+class TaskSetup:
+    """A task scenario in SI units, ready to run.
+
+    Attributes:
+        arm: The robot.
+        obstacles: The obstacles, in [m].
+        waypoints: Joint angles of each named waypoint, shape (5,), in [rad].
+        route: ``(from, to)`` waypoint names of each segment.
+        limits: Joint limits used for timing, IK and the limit check.
+        plan: The planned motion (segment ``i`` goes ``route[i]``).
+        writing_plane: The writing surface, or None.
+    """
+
+    arm: Arm
+    obstacles: tuple[Obstacle, ...]
+    waypoints: dict[str, np.ndarray]
+    route: tuple[tuple[str, str], ...]
+    limits: MotionLimits
+    plan: Plan
+    writing_plane: WritingPlane | None
+
+
+class _InvalidError(Exception):
+    """A resolution problem at a key path (converted to a ValidationError)."""
+
+    def __init__(self, loc: tuple[str | int, ...], message: str, value: Any = None) -> None:
+        super().__init__(message)
+        self.loc, self.message, self.value = loc, message, value
+
+
+def resolve(scenario: Scenario) -> TaskSetup:
+    """Resolve a schema-valid scenario; ValidationError (with the key path) if it cannot be."""
+    try:
+        return _resolve(scenario)
+    except _InvalidError as problem:
+        error = PydanticCustomError("task_scenario", problem.message.replace("{", "{{"))
+        raise ValidationError.from_exception_data(
+            "task scenario",
+            [InitErrorDetails(type=error, loc=problem.loc, input=problem.value)],
+        ) from problem
+
+
+def _resolve(scenario: Scenario) -> TaskSetup:
+    from lynxplan.trajectory.plan import Plan
+
+    length = length_factor(scenario.units.length)
+    angle = angle_factor(scenario.units.angle)
+    arm = load_robot(scenario.robot)
+    limits = _limits(scenario, arm, angle)
+    obstacles = tuple(_obstacles(scenario, length, angle))
+    waypoints = {
+        name: _waypoint(name, entry, arm, length, angle)
+        for name, entry in scenario.waypoints.items()
+    }
+    route = _route(scenario)
+    q = waypoints[route[0][0]]
+    segments = []
+    for i, ((_, target), entry) in enumerate(zip(route, scenario.segments, strict=True)):
+        segment = _segment(i, entry, waypoints[target], q, scenario, limits)
+        segments.append(segment)
+        q = segment.q_end
+    plane = None
+    if scenario.writing_plane is not None:
+        wp = scenario.writing_plane
+        plane = WritingPlane(
+            np.array(wp.point) * length, float(wp.tilt) * angle, np.array(wp.size) * length
+        )
+    return TaskSetup(arm, obstacles, waypoints, route, limits, Plan(tuple(segments), limits), plane)
+
+
+def load_robot(entry: RobotEntry) -> Arm:
+    """The arm of the scenario; _InvalidError naming the key when it is not usable for a task."""
+    from lynxplan.arm.model import load_arm
+
+    if entry.example_robot_data is not None:
+        _reject_example_robot(entry.example_robot_data)
+    try:
+        return load_arm(entry.urdf)
+    except LynxplanError as exc:
+        raise _InvalidError(
+            ("robot", "urdf"),
+            f"{exc}; task scenarios plan with the AL5's analytic IK and need its joint structure",
+            entry.urdf,
+        ) from exc
+
+
+def _reject_example_robot(name: str) -> None:
+    """Load an example-robot-data robot to name it in the message, then reject it."""
+    try:
+        import example_robot_data
+
+        robot = example_robot_data.load(name)
+    except Exception as exc:  # the loader raises ValueError, ImportError, RuntimeError...
+        known = ", ".join(sorted(getattr(example_robot_data, "ROBOTS", {}))[:40])
+        detail = f"; known names: {known}" if known else ""
+        raise _InvalidError(
+            ("robot", "example_robot_data"), f"cannot load {name!r}: {exc}{detail}", name
+        ) from exc
+    raise _InvalidError(
+        ("robot", "example_robot_data"),
+        f"{name!r} loaded ({robot.model.nq} joints), but task scenarios plan with the AL5's "
+        "analytic IK and need its 5-joint structure; use this robot with lynxplan.viz and "
+        "lynxplan.collision directly",
+        name,
+    )
+
+
+def _limits(scenario: Scenario, arm: Arm, angle: float) -> MotionLimits:
+    from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, MotionLimits
+
+    entry = scenario.limits
+
+    def scaled(value: Any, default: Any) -> np.ndarray:
+        return np.asarray(default if value is None else np.asarray(value) * angle, dtype=float)
+
+    return MotionLimits(
+        arm.limits.position,
+        scaled(entry.velocity, arm.limits.velocity),
+        scaled(entry.acceleration, DEFAULT_MAX_ACCELERATION),
+        scaled(entry.jerk, DEFAULT_MAX_JERK),
+    )
+
+
+def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
+    """Fixed-axis roll-pitch-yaw (rad) -> rotation ``Rz(yaw) Ry(pitch) Rx(roll)``, shape (3, 3)."""
+    r, p, y = rpy
+    rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
+    ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
+    rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
+    return rz @ ry @ rx
+
+
+def _rotation(entry: BoxEntry | CylinderEntry, angle: float) -> np.ndarray | None:
+    if entry.rpy is not None:
+        return rpy_matrix(np.array(entry.rpy) * angle)
+    if entry.rotation is not None:
+        return np.array(entry.rotation, dtype=float)
+    return None
+
+
+def _obstacles(scenario: Scenario, length: float, angle: float) -> list[Obstacle]:
+    built: list[Obstacle] = []
+    for i, entry in enumerate(scenario.obstacles):
+        name = entry.name or f"obstacle_{i}"
+        if name in [o.name for o in built]:
+            raise _InvalidError(("obstacles", i, "name"), f"duplicate obstacle name {name!r}", name)
+        try:
+            built.append(_obstacle(entry, name, length, angle))
+        except LynxplanError as exc:
+            raise _InvalidError(("obstacles", i), str(exc)) from exc
+    return built
+
+
+def _obstacle(
+    entry: BoxEntry | SphereEntry | CylinderEntry, name: str, length: float, angle: float
+) -> Obstacle:
+    from lynxplan.collision.obstacles import (
+        BoxObstacle,
+        CylinderObstacle,
+        SphereObstacle,
+        axis_aligned_box,
+        rotation_from_axis,
+    )
+
+    if entry.type == "sphere":
+        return SphereObstacle(name, np.array(entry.centre) * length, entry.radius * length)
+    rotation = _rotation(entry, angle)
+    if entry.type == "box":
+        size = np.array(entry.size) * length
+        if entry.min_corner is not None:
+            return axis_aligned_box(name, np.array(entry.min_corner) * length, size)
+        centre = np.array(entry.centre) * length
+        return BoxObstacle(name, centre, size, np.eye(3) if rotation is None else rotation)
+    if entry.axis is not None:
+        rotation = rotation_from_axis(entry.axis)
+    return CylinderObstacle(
+        name,
+        np.array(entry.centre) * length,
+        entry.radius * length,
+        entry.length * length,
+        np.eye(3) if rotation is None else rotation,
+    )
+
+
+def _waypoint(name: str, entry: WaypointEntry, arm: Arm, length: float, angle: float) -> np.ndarray:
+    loc: tuple[str | int, ...] = ("waypoints", name)
+    if entry.q is not None:
+        q = np.array(entry.q) * angle
+        _check_within_limits(q, arm, (*loc, "q"), angle)
+        return q
+    reference = None if entry.q_reference is None else np.array(entry.q_reference) * angle
+    if entry.pose is not None:
+        pose = np.eye(4)
+        pose[: len(entry.pose)] = np.array(entry.pose)
+        pose[:3, 3] *= length
+        key = "pose"
+    else:
+        pose = _approach_pose(np.array(entry.position) * length, np.array(entry.approach))
+        key = "position"
+    try:
+        result = arm.ik(
+            pose,
+            q_reference=reference,
+            select="nearest" if entry.ik == "nearest" else "report",
+            approach_only=entry.pose is None,
+        )
+        return np.array(result.q)
+    except LynxplanError as exc:
+        raise _InvalidError((*loc, key), f"unreachable waypoint: {exc}") from exc
+
+
+def _approach_pose(position: np.ndarray, approach: np.ndarray) -> np.ndarray:
+    """A pose whose z axis is ``approach`` (the IK only uses that axis: approach_only)."""
+    from lynxplan.collision.obstacles import rotation_from_axis
+
+    pose = np.eye(4)
+    pose[:3, :3] = rotation_from_axis(approach)
+    pose[:3, 3] = position
+    return pose
+
+
+def _check_within_limits(q: np.ndarray, arm: Arm, loc: tuple[str | int, ...], angle: float) -> None:
+    lower, upper = arm.limits.lower, arm.limits.upper
+    for j in range(len(q)):
+        if not lower[j] - LIMIT_SNAP_TOLERANCE <= q[j] <= upper[j] + LIMIT_SNAP_TOLERANCE:
+            raise _InvalidError(
+                (*loc, j),
+                f"q{j + 1} = {q[j] / angle:.6g} is outside the joint limits "
+                f"[{lower[j] / angle:.6g}, {upper[j] / angle:.6g}] (file's angle unit)",
+                q[j] / angle,
+            )
+
+
+def _route(scenario: Scenario) -> tuple[tuple[str, str], ...]:
+    names = list(scenario.waypoints)
+    valid = ", ".join(names)
+    route: list[tuple[str, str]] = []
+    previous: str | None = None
+    for i, entry in enumerate(scenario.segments):
+        for key, value in (("from", entry.from_), ("to", entry.to)):
+            if value is not None and value not in scenario.waypoints:
+                raise _InvalidError(
+                    ("segments", i, key), f"unknown waypoint {value!r}; waypoints: {valid}", value
+                )
+        start = entry.from_ if entry.from_ is not None else previous
+        if start is None:
+            raise _InvalidError(
+                ("segments", 0, "from"), "the first segment needs a 'from' waypoint"
+            )
+        if previous is not None and start != previous:
+            raise _InvalidError(
+                ("segments", i, "from"),
+                f"{start!r} but segment {i - 1} ends at {previous!r} (segments are chained)",
+                start,
+            )
+        route.append((start, entry.to))
+        previous = entry.to
+    return tuple(route)
+
+
+def _segment(
+    i: int,
+    entry: Any,
+    target: np.ndarray,
+    q: np.ndarray,
+    scenario: Scenario,
+    limits: MotionLimits,
+) -> Any:
+    from lynxplan.trajectory.lspb import LspbTiming
+    from lynxplan.trajectory.plan import SegmentSpec, build_plan
+
+    timing_entry = entry.timing if entry.timing is not None else scenario.timing
+    timing = None if timing_entry == "auto" else LspbTiming(timing_entry.tt, timing_entry.ta)
+    spec = SegmentSpec(entry.motion, target_q=target, timing=timing, mode=entry.orientation)
+    try:
+        return build_plan(q, [spec], limits).segments[0]
+    except LynxplanError as exc:
+        raise _InvalidError(
+            ("segments", i), f"{entry.motion} motion to {entry.to!r}: {exc}"
+        ) from exc
