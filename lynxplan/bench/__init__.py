@@ -13,6 +13,7 @@ from typing import NamedTuple
 
 #: Section name -> module with ``run(quick) -> list[Figure]``.
 SECTIONS: dict[str, str] = {
+    "singularity": "lynxplan.bench.singularity",
     "arm": "lynxplan.bench.arm",
     "parallel": "lynxplan.bench.parallel",
     "trajectory": "lynxplan.bench.trajectory",

@@ -58,3 +58,12 @@ def test_invalid_scenarios(tmp_path: Path, old: str, new: str, match: str) -> No
     path.write_text(text.replace(old, new, 1))
     with pytest.raises(ScenarioError, match=match):
         load_scenario(path)
+
+
+def test_full_run_writes_the_plots(tmp_path: Path) -> None:
+    outcome = run_scenario(SCENARIO, tmp_path / "full", quick=False)
+    assert outcome.ok
+    for name in ("manipulability", "joint_speeds", "tracking_error", "tool_paths"):
+        png = tmp_path / "full" / f"{name}.png"
+        assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+        assert png.stat().st_size > 10_000
