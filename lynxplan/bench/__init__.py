@@ -13,8 +13,8 @@ from typing import NamedTuple
 
 #: Section name -> module with ``run(quick) -> list[Figure]``.
 SECTIONS: dict[str, str] = {
-    "singularity": "lynxplan.bench.singularity",
     "arm": "lynxplan.bench.arm",
+    "singularity": "lynxplan.bench.singularity",
     "parallel": "lynxplan.bench.parallel",
     "trajectory": "lynxplan.bench.trajectory",
     "collision": "lynxplan.bench.collision",

@@ -7,6 +7,8 @@ import math
 import numpy as np
 import pinocchio as pin
 import pytest
+from hypothesis import assume, given, settings
+from hypothesis import strategies as st
 
 from lynxplan.arm import Arm
 from lynxplan.exceptions import InputError, ShapeError, TaskError
@@ -181,3 +183,22 @@ def test_task_errors() -> None:
     with pytest.raises(InputError, match="one configuration"):
         singularity_distances(np.zeros((2, 5)))
     assert make_task(["vx", "vy", "vz", "pitch"]).name == "position_pitch"
+
+
+@settings(max_examples=60, deadline=None)
+@given(st.lists(st.floats(min_value=-3.0, max_value=3.0, allow_nan=False), min_size=5, max_size=5))
+def test_gradient_property_position(q: list[float]) -> None:
+    config = np.array(q)
+    assume(manipulability(config, "position") > 1e-5)
+    grad = manipulability_gradient(config, "position")
+    fd = np.array(
+        [
+            (
+                manipulability(config + FD_STEP * e, "position")
+                - manipulability(config - FD_STEP * e, "position")
+            )
+            / (2 * FD_STEP)
+            for e in np.eye(5)
+        ]
+    )
+    np.testing.assert_allclose(grad, fd, rtol=FD_RTOL, atol=FD_ATOL)

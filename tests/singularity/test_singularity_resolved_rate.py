@@ -232,3 +232,16 @@ def test_parameter_errors(problem: ResolvedRateProblem) -> None:
         run_resolved_rate(problem, "newton")
     with pytest.raises(InputError, match="max_steps must be >= 1"):
         run_resolved_rate(problem, "pinv", max_steps=0)
+
+
+def test_position_only_task_runs_the_line(arm: Arm, problem: ResolvedRateProblem) -> None:
+    # Redundant task (3 rows, 4 moving joints): the minimum-norm pseudo-inverse also has to turn
+    # the base through half a revolution near the axis; the damped strategies do not.
+    position = ResolvedRateProblem(
+        problem.path, problem.q0, "position", problem.parameters, gain=problem.gain
+    )
+    metrics = {s: run_metrics(r, position, arm.limits) for s, r in run_all(position).items()}
+    assert metrics[Strategy.PINV].speed_limit_exceeded
+    assert not metrics[Strategy.SPEED_LIMIT].speed_limit_exceeded
+    assert metrics[Strategy.SPEED_LIMIT].max_tracking_error < 1e-4
+    assert metrics[Strategy.PINV].max_pitch_error == 0.0  # pitch is not a task row
