@@ -1,9 +1,27 @@
-"""lynxplan: modelling and planning for small robot arms and planar parallel robots."""
+"""lynxplan: modelling and planning for small robot arms and planar parallel robots.
+
+``import lynxplan`` is cheap; the arm model (numba, Pinocchio) loads on first use of
+:func:`load_arm`.
+"""
 
 from __future__ import annotations
 
-__version__ = "0.1.0"
+from typing import TYPE_CHECKING, Any
 
 from lynxplan.exceptions import LynxplanError
 
-__all__ = ["LynxplanError", "__version__"]
+__version__ = "0.1.0"
+
+if TYPE_CHECKING:
+    from lynxplan.arm.model import Arm, load_arm
+
+__all__ = ["Arm", "LynxplanError", "__version__", "load_arm"]
+
+
+def __getattr__(name: str) -> Any:
+    """Lazy attributes: ``lynxplan.load_arm`` and ``lynxplan.Arm``."""
+    if name in ("load_arm", "Arm"):
+        from lynxplan.arm import model
+
+        return getattr(model, name)
+    raise AttributeError(f"module 'lynxplan' has no attribute {name!r}")

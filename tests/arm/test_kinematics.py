@@ -125,3 +125,11 @@ def test_fk_into_preallocated_output() -> None:
     np.testing.assert_array_equal(out, forward_kinematics(q))
     with pytest.raises(ShapeError, match="out must have shape"):
         forward_kinematics(q, out=np.empty((6, 4, 4)))
+
+
+def test_top_level_load_arm_is_the_shared_default() -> None:
+    import lynxplan
+    from lynxplan.arm import load_arm
+
+    assert lynxplan.load_arm() is load_arm()
+    np.testing.assert_allclose(lynxplan.load_arm().fk(np.zeros(5))[:3, 3], [0.333375, 0, -0.085725])
