@@ -1,0 +1,117 @@
+"""pytest plugin: scenario YAML files as test items (``pytest scenarios/``).
+
+Registered as the ``pytest11`` entry point ``lynxplan``. A YAML file with a top-level ``kind:``
+key is collected when it was given on the command line or lies under a folder named
+``scenarios``. Each file is one test item: the scenario runs with ``quick=True`` and no output
+folder (no plots, HTML or files), and the item fails with the ``expect:`` entries that did not
+hold, or with the scenario error (file, key path, reason).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+import yaml
+
+from lynxplan.exceptions import LynxplanError
+from lynxplan.scenario import Outcome
+
+#: Folder name under which YAML files are collected without being named on the command line.
+SCENARIO_FOLDER = "scenarios"
+
+
+class ExpectationFailedError(AssertionError):
+    """A scenario ran but some of its expectations did not hold.
+
+    Attributes:
+        path: The scenario file.
+        outcome: What the run produced (summary and failed expectations).
+    """
+
+    def __init__(self, path: Path, outcome: Outcome) -> None:
+        self.path = path
+        self.outcome = outcome
+        lines = "\n".join(f"  - {failure}" for failure in outcome.failed_expectations)
+        super().__init__(
+            f"{path}: {len(outcome.failed_expectations)} expectation(s) failed:\n{lines}"
+        )
+
+
+def run_scenario_file(path: str | Path) -> Outcome:
+    """Run a scenario the way the plugin does (quick, nothing written); returns its outcome."""
+    from lynxplan.runner import run_scenario
+
+    return run_scenario(path, None, quick=True)
+
+
+def check_scenario_file(path: str | Path) -> Outcome:
+    """Run a scenario and raise :class:`ExpectationFailedError` if an expectation fails.
+
+    Raises:
+        ExpectationFailedError: listing the failed expectations.
+        ScenarioError: the file is invalid (file, key path, reason).
+    """
+    outcome = run_scenario_file(path)
+    if not outcome.ok:
+        raise ExpectationFailedError(Path(path), outcome)
+    return outcome
+
+
+def is_scenario_file(path: Path) -> bool:
+    """A YAML mapping with a ``kind`` key (an unparsable YAML file counts: its error is shown)."""
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except yaml.YAMLError:
+        return True
+    except (OSError, UnicodeDecodeError):
+        return False
+    return isinstance(data, dict) and "kind" in data
+
+
+def _under_scenario_folder(path: Path, root: Path) -> bool:
+    try:
+        parts = path.relative_to(root).parts
+    except ValueError:
+        parts = path.parts
+    return SCENARIO_FOLDER in parts[:-1]
+
+
+def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Collector | None:
+    """Collect scenario YAML files (see the module docstring for which ones)."""
+    if file_path.suffix not in (".yaml", ".yml"):
+        return None
+    explicit = parent.session.isinitpath(file_path)
+    if not (explicit or _under_scenario_folder(file_path, parent.config.rootpath)):
+        return None
+    if not is_scenario_file(file_path):
+        return None
+    return ScenarioFile.from_parent(parent, path=file_path)
+
+
+class ScenarioFile(pytest.File):
+    """A scenario YAML file: one item."""
+
+    def collect(self) -> Iterator[pytest.Item]:
+        """The file's single scenario item."""
+        yield ScenarioItem.from_parent(self, name="scenario")
+
+
+class ScenarioItem(pytest.Item):
+    """Runs one scenario (quick, no outputs) and checks its ``expect:`` block."""
+
+    def runtest(self) -> None:
+        """Run the scenario; ExpectationFailedError or a LynxplanError fails the item."""
+        check_scenario_file(self.path)
+
+    def repr_failure(self, excinfo: Any, style: Any = None) -> Any:
+        """Failed expectations or the scenario error as plain lines, no traceback."""
+        if isinstance(excinfo.value, (ExpectationFailedError, LynxplanError)):
+            return str(excinfo.value)
+        return super().repr_failure(excinfo)
+
+    def reportinfo(self) -> tuple[Path, int, str]:
+        """Location shown in reports."""
+        return self.path, 0, f"scenario {self.path.name}"
