@@ -18,6 +18,7 @@ SECTIONS: dict[str, str] = {
     "parallel": "lynxplan.bench.parallel",
     "trajectory": "lynxplan.bench.trajectory",
     "collision": "lynxplan.bench.collision",
+    "task": "lynxplan.bench.task",
 }
 
 
