@@ -6,6 +6,8 @@ on. The CLI prints that line and exits non-zero; it never shows a traceback for 
 
 from __future__ import annotations
 
+import math
+
 
 class LynxplanError(Exception):
     """Base class of every error raised by lynxplan on purpose."""
@@ -197,6 +199,11 @@ def leg_unreachable_reason(
     )
 
 
+def _degrees(theta: tuple[float, ...]) -> str:
+    """Angles in [rad] as a comma-separated list in degrees, for messages."""
+    return ", ".join(f"{math.degrees(t):.4f}" for t in theta)
+
+
 class DegenerateForwardKinematicsError(KinematicsError):
     """Forward kinematics of the 3-RRR has a continuum of solutions (architecture singularity).
 
@@ -206,7 +213,7 @@ class DegenerateForwardKinematicsError(KinematicsError):
 
     def __init__(self, theta: tuple[float, float, float]) -> None:
         self.theta = theta
-        degrees = ", ".join(f"{t * 57.29577951308232:.4f}" for t in theta)
+        degrees = _degrees(theta)
         super().__init__(
             f"parallel robot: the actuated angles ({degrees}) deg leave the platform free to move "
             "(the closure polynomial vanishes identically); forward kinematics is not finite"
@@ -222,7 +229,7 @@ class NoAssemblyModeError(KinematicsError):
 
     def __init__(self, theta: tuple[float, float, float]) -> None:
         self.theta = theta
-        degrees = ", ".join(f"{t * 57.29577951308232:.4f}" for t in theta)
+        degrees = _degrees(theta)
         super().__init__(
             f"parallel robot: the actuated angles ({degrees}) deg admit no assembly mode "
             "(the distal links cannot all meet the platform)"

@@ -76,6 +76,26 @@ class IkBatch(NamedTuple):
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
+def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: bool) -> None:
+    """Gram-Schmidt from the approach axis, in place: a normalised; unless ``approach_only``,
+    n made orthogonal to a and normalised, and o = a x n."""
+    scale = 1.0 / math.sqrt(_dot3(a, a))
+    for i in range(3):
+        a[i] *= scale
+    if approach_only:
+        return
+    along = _dot3(n, a)
+    for i in range(3):
+        n[i] -= along * a[i]
+    scale = 1.0 / math.sqrt(_dot3(n, n))
+    for i in range(3):
+        n[i] *= scale
+    o[0] = a[1] * n[2] - a[2] * n[1]
+    o[1] = a[2] * n[0] - a[0] * n[2]
+    o[2] = a[0] * n[1] - a[1] * n[0]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
 def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
     turns = math.floor((x - lo) / TWO_PI)  # floor is one instruction; % calls fmod
@@ -173,19 +193,7 @@ def ik_kernel(
         if dev > RIGIDITY_REPAIR_TOLERANCE_K:
             status_out[k] = IkStatus.NOT_RIGID
             continue
-        scale = 1.0 / math.sqrt(_dot3(a_t, a_t))
-        for i in range(3):
-            a_t[i] *= scale
-        if not approach_only:
-            along = _dot3(n_t, a_t)
-            for i in range(3):
-                n_t[i] -= along * a_t[i]
-            scale = 1.0 / math.sqrt(_dot3(n_t, n_t))
-            for i in range(3):
-                n_t[i] *= scale
-            o_t[0] = a_t[1] * n_t[2] - a_t[2] * n_t[1]
-            o_t[1] = a_t[2] * n_t[0] - a_t[0] * n_t[2]
-            o_t[2] = a_t[0] * n_t[1] - a_t[1] * n_t[0]
+        _orthonormalise(a_t, n_t, o_t, approach_only)
 
         # Arm plane: radial unit vector towards the tool point (front branch).
         rho = math.sqrt(px * px + py * py)
@@ -479,24 +487,8 @@ def ik_single_kernel(
         reached = np.empty((4, 4, 4))
         fk_kernel(q[0], a2, a3, d5, reached)
         # The target as the kernel used it: orthonormalised from the approach axis.
-        target = np.empty((3, 3))
-        a = target[:, 2]
-        n = target[:, 0]
-        for i in range(3):
-            a[i], n[i] = T[i, 2], T[i, 0]
-        scale = 1.0 / math.sqrt(_dot3(a, a))
-        for i in range(3):
-            a[i] *= scale
-        if not approach_only:
-            along = _dot3(n, a)
-            for i in range(3):
-                n[i] -= along * a[i]
-            scale = 1.0 / math.sqrt(_dot3(n, n))
-            for i in range(3):
-                n[i] *= scale
-        target[0, 1] = a[1] * n[2] - a[2] * n[1]
-        target[1, 1] = a[2] * n[0] - a[0] * n[2]
-        target[2, 1] = a[0] * n[1] - a[1] * n[0]
+        n, o, a = T[:3, 0].copy(), np.zeros(3), T[:3, 2].copy()
+        _orthonormalise(a, n, o, approach_only)
         best = np.inf
         for b in range(4):
             rows[b, 5] = 1.0 if within[0, b] else 0.0
@@ -511,8 +503,8 @@ def ik_single_kernel(
                 rows[b, 7] = math.acos(min(1.0, max(-1.0, cosine)))
             else:
                 rows[b, 7] = _angle_between_frames(
-                    target[:, 0],
-                    target[:, 1],
+                    n,
+                    o,
                     a,
                     reached[b, :3, 0],
                     reached[b, :3, 1],

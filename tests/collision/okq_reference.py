@@ -5,26 +5,11 @@ from __future__ import annotations
 import numpy as np
 
 from lynxplan.collision import axis_aligned_box
+from lynxplan.trajectory.ok_task import ok_task_configurations
 from lynxplan.units import INCH
 
-WAYPOINTS_DEG = np.array(
-    [
-        [104, 57, -59, 40, 0],
-        [109, 79, -93, 25, 0],
-        [97, 83, -97, 26, 0],
-        [95, 60, -63, 40, 0],
-        [104, 57, -59, 40, 0],
-        [90, 90, -30, 0, 0],
-        [81, 60, -63, 40, 0],
-        [77.7, 83, -97.5, 26, 0],
-        [77.7, 100, -60, 26, 0],
-        [75.5, 57, -59, 41, 0],
-        [79, 70, -77, 29, 0],
-        [64.7, 72.7, -84.7, 19.4, 0],
-        [30, 90, -30, 30, 0],
-        [0, 0, 0, 0, 0],
-    ]
-)
+#: SPEC Part 3 waypoints, shape (14, 5), in [deg] (the package's table, not a copy).
+WAYPOINTS_DEG = np.degrees(ok_task_configurations())
 
 
 def spec_obstacles() -> list:
