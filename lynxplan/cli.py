@@ -34,7 +34,10 @@ class _Parser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     """The full ``lynxplan`` parser with every sub-command registered."""
-    parser = _Parser(prog="lynxplan", description=__doc__.splitlines()[0] if __doc__ else None)
+    parser = _Parser(
+        prog="lynxplan",
+        description="Modelling and planning for a 5-DOF arm and a planar 3-RRR parallel robot.",
+    )
     parser.add_argument("--version", action="version", version=f"lynxplan {__version__}")
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     subparsers.required = True
@@ -55,6 +58,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     except KeyboardInterrupt:
         sys.stderr.write("lynxplan: interrupted\n")
         return 130
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
+        sys.stderr.close()
+        return 0
     return code
 
 
