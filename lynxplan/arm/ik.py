@@ -96,6 +96,18 @@ def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: 
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
+def _mark_unsolved(
+    k: int, q_out: np.ndarray, within_out: np.ndarray, residual_out: np.ndarray
+) -> None:
+    """NaN angles and residual, no branch within limits, for pose k (loops: no views)."""
+    residual_out[k] = np.nan
+    for b in range(4):
+        within_out[k, b] = False
+        for j in range(5):
+            q_out[k, b, j] = np.nan
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
 def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
     turns = math.floor((x - lo) / TWO_PI)  # floor is one instruction; % calls fmod
@@ -159,11 +171,6 @@ def ik_kernel(
     for k in range(T.shape[0]):
         # Plain indices, no per-pose views: a view costs reference-count updates in numba.
         r_k = k if q_ref.shape[0] > 1 else 0
-        for b in range(4):  # overwritten when solved (loops, not slices: no views)
-            within_out[k, b] = False
-            for j in range(5):
-                q_out[k, b, j] = np.nan
-        residual_out[k] = np.nan
         miss_out[k] = 0.0
         deviation_out[k] = 0.0
         finite = True
@@ -173,6 +180,7 @@ def ik_kernel(
                     finite = False
         if not finite:
             status_out[k] = IkStatus.NON_FINITE
+            _mark_unsolved(k, q_out, within_out, residual_out)
             continue
         px, py, pz = T[k, 0, 3], T[k, 1, 3], T[k, 2, 3]
         for i in range(3):
@@ -182,7 +190,7 @@ def ik_kernel(
         dev = max(abs(T[k, 3, 0]), abs(T[k, 3, 1]), abs(T[k, 3, 2]), abs(T[k, 3, 3] - 1.0))
         if not approach_only:
             for i in range(3):
-                for j in range(3):
+                for j in range(i, 3):  # R^T R is symmetric
                     dot = (
                         T[k, 0, i] * T[k, 0, j] + T[k, 1, i] * T[k, 1, j] + T[k, 2, i] * T[k, 2, j]
                     )
@@ -192,6 +200,7 @@ def ik_kernel(
         deviation_out[k] = dev
         if dev > RIGIDITY_REPAIR_TOLERANCE_K:
             status_out[k] = IkStatus.NOT_RIGID
+            _mark_unsolved(k, q_out, within_out, residual_out)
             continue
         _orthonormalise(a_t, n_t, o_t, approach_only)
 
@@ -224,6 +233,7 @@ def ik_kernel(
             miss_out[k] = abs(a2 - a3) - dist
         if miss_out[k] > REACH_TOLERANCE_K:
             status_out[k] = IkStatus.OUT_OF_REACH
+            _mark_unsolved(k, q_out, within_out, residual_out)
             continue
         c3 = (r_w * r_w + z_w * z_w - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
         c3 = min(1.0, max(-1.0, c3))  # elbow stretched or folded: clamp
