@@ -137,7 +137,12 @@ def _angle_between_frames(
     m02, m20 = _dot3(n_t, a_s), _dot3(a_t, n_s)
     m12, m21 = _dot3(o_t, a_s), _dot3(a_t, o_s)
     sx, sy, sz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
-    return atan2(math.sqrt(sx * sx + sy * sy + sz * sz), 0.5 * (m00 + m11 + m22 - 1.0))
+    sine = math.sqrt(sx * sx + sy * sy + sz * sz)
+    cosine = 0.5 * (m00 + m11 + m22 - 1.0)
+    if sine < 1e-4 and cosine > 0.0:
+        # Reachable targets land here: asin(x) = x + x^3/6 + O(x^5), exact to ~1e-21 rad.
+        return sine + sine * sine * sine / 6.0
+    return atan2(sine, cosine)
 
 
 @numba.njit(cache=True, nogil=True)
