@@ -110,6 +110,8 @@ def _mark_unsolved(
 @numba.njit(cache=True, nogil=True, inline="always")
 def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
+    if lo <= x <= hi:
+        return x, True
     turns = math.floor((x - lo) / TWO_PI)  # floor is one instruction; % calls fmod
     y = x - turns * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
     if y <= hi:
@@ -254,6 +256,10 @@ def ik_kernel(
         n_x4 = n_t[0] * c1 * c234 + n_t[1] * s1 * c234 + n_t[2] * s234
         n_y4 = n_t[0] * s1 - n_t[1] * c1
         q5_front = q_ref[r_k, 4] if approach_only else atan2(n_y4, n_x4)
+        # q3 takes the values -q3_abs and +q3_abs, q1 and q5 one value per base branch: wrap
+        # each once (14 wraps a pose instead of 20).
+        q3_neg, q3_neg_in = _wrap_into_limits(-q3_abs, lower[2], upper[2], limit_tol)
+        q3_pos, q3_pos_in = _wrap_into_limits(q3_abs, lower[2], upper[2], limit_tol)
         for base in range(2):
             if base == 0:
                 q1, q234, phi, q5, r_b = q1_front, q234_front, phi_front, q5_front, r_w
@@ -264,23 +270,24 @@ def ik_kernel(
                 if not approach_only:
                     q5 = q5_front - math.pi if q5_front > 0.0 else q5_front + math.pi
                 r_b = -r_w
+            q1_wrapped, q1_in = _wrap_into_limits(q1, lower[0], upper[0], limit_tol)
+            q5_wrapped, q5_in = _wrap_into_limits(q5, lower[4], upper[4], limit_tol)
             for elbow in range(2):
                 # Elbow above the shoulder-wrist line: q3 < 0 when the wrist is ahead (r_b >= 0).
-                up = elbow == 0
-                q3 = -q3_abs if (up == (r_b >= 0.0)) else q3_abs
-                q2 = phi + beta if q3 < 0.0 else phi - beta
+                negative = (elbow == 0) == (r_b >= 0.0)
+                q3 = -q3_abs if negative else q3_abs
+                q2 = phi + beta if negative else phi - beta
                 q4 = q234 - q2 - q3
+                q2_wrapped, q2_in = _wrap_into_limits(q2, lower[1], upper[1], limit_tol)
+                q4_wrapped, q4_in = _wrap_into_limits(q4, lower[3], upper[3], limit_tol)
                 branch = 2 * base + elbow
-                ok = True
-                for joint, value in enumerate((q1, q2, q3, q4, q5)):
-                    lo, hi = lower[joint], upper[joint]
-                    if lo <= value <= hi:
-                        q_out[k, branch, joint] = value
-                    else:
-                        wrapped, inside = _wrap_into_limits(value, lo, hi, limit_tol)
-                        q_out[k, branch, joint] = wrapped
-                        ok = ok and inside
-                within_out[k, branch] = ok
+                q_out[k, branch, 0] = q1_wrapped
+                q_out[k, branch, 1] = q2_wrapped
+                q_out[k, branch, 2] = q3_neg if negative else q3_pos
+                q_out[k, branch, 3] = q4_wrapped
+                q_out[k, branch, 4] = q5_wrapped
+                q3_in = q3_neg_in if negative else q3_pos_in
+                within_out[k, branch] = q1_in and q2_in and q3_in and q4_in and q5_in
         # Reached orientation (same for every branch, before any snapping onto a limit).
         a_s[0], a_s[1], a_s[2] = c1 * s234, s1 * s234, -c234
         if approach_only:
