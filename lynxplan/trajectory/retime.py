@@ -6,9 +6,12 @@ Methods, per segment:
 - ``lspb_auto``: the shortest synchronised LSPB within the velocity and acceleration limits;
 - ``ruckig``: time-optimal, jerk-limited rest-to-rest motion (free segments only: ruckig goes
   state to state, it does not follow a Cartesian line);
-- ``ruckig_lspb_duration``: ruckig forced to the segment's LSPB duration (profile shape);
+- ``ruckig_lspb_duration``: ruckig forced to the segment's LSPB duration (profile shape). When
+  that duration is shorter than ruckig's jerk-limited minimum, ruckig returns its minimum
+  instead: :attr:`ProfileStats.duration_matched` is then False;
 - ``toppra``: time-optimal parameterisation of the same geometric joint path under joint
-  velocity and acceleration limits (free and straight-line segments).
+  velocity and acceleration limits (free and straight-line segments), verified on its samples
+  and slowed down uniformly if needed (:func:`toppra_profile`, :attr:`ProfileStats.time_scale`).
 
 Every figure is measured on the sampled output, not taken from the libraries: peaks of |qd|,
 |qdd| and |jerk| (finite differences of the sampled acceleration), and limit violations. LSPB and
@@ -36,6 +39,15 @@ from lynxplan.trajectory.timing import auto_timing_linear, auto_timing_path
 METHODS = ("lspb", "lspb_auto", "ruckig", "ruckig_lspb_duration", "toppra")
 #: Methods whose jerk is bounded by construction (the others' sampled jerk is impulsive).
 JERK_LIMITED_METHODS = ("ruckig", "ruckig_lspb_duration")
+#: toppra is given the limits times this factor: it enforces them on its grid points only, and
+#: the margin absorbs the spline's overshoot in between (the samples are still verified).
+TOPPRA_LIMIT_SAFETY = 0.99
+#: Grid points of toppra's discretisation on a free segment (a straight joint line).
+TOPPRA_FREE_GRID_POINTS = 101
+#: A forced duration counts as matched when the result is within this of it, in [s].
+DURATION_MATCH_TOLERANCE = 1e-9
+#: Rounds of uniform slow-down of a toppra profile before giving up.
+TOPPRA_RESCALE_ROUNDS = 5
 
 
 class Profile(NamedTuple):
@@ -49,6 +61,10 @@ class Profile(NamedTuple):
     """Joint velocities, shape (N, 5), in [rad/s]."""
     qdd: np.ndarray
     """Joint accelerations, shape (N, 5), in [rad/s^2]."""
+    time_scale: float = 1.0
+    """Uniform slow-down applied after the library's result (toppra), >= 1."""
+    requested_duration: float | None = None
+    """Duration the method was asked to meet (ruckig forced to the LSPB's), in [s]."""
 
     @property
     def jerk(self) -> np.ndarray:
@@ -78,6 +94,10 @@ class ProfileStats(NamedTuple):
     """Largest peak acceleration / limit over joints (> 1 is a violation)."""
     violations: tuple[str, ...]
     """Human-readable limit violations (position, velocity, acceleration; jerk for ruckig)."""
+    time_scale: float = 1.0
+    """Uniform slow-down factor applied to the library's result (toppra; 1 = none)."""
+    duration_matched: bool | None = None
+    """Whether a forced duration was met (ruckig forced to the LSPB's); None if not forced."""
 
 
 def sample_times(duration: float, rate: float) -> np.ndarray:
@@ -141,7 +161,7 @@ def ruckig_profile(
         raise RetimingError("ruckig", str(result))
     t = sample_times(trajectory.duration, rate)
     states = np.array([trajectory.at_time(float(x)) for x in t])  # (N, 3, 5)
-    return Profile(t, states[:, 0], states[:, 1], states[:, 2])
+    return Profile(t, states[:, 0], states[:, 1], states[:, 2], requested_duration=minimum_duration)
 
 
 def toppra_profile(
@@ -150,8 +170,18 @@ def toppra_profile(
     """Time-optimal parameterisation of the segment's joint path by toppra, sampled at ``rate``.
 
     The path is a cubic spline through the segment's joint path on its grid (a straight joint
-    line for free motion). toppra enforces the limits on its grid points only: its sampled
-    output can exceed them slightly in between, which the statistics report.
+    line for free motion); toppra discretises it on the same grid (a line segment's IK grid,
+    :data:`TOPPRA_FREE_GRID_POINTS` points on a free segment). toppra enforces the limits on its
+    grid points only, so it is given the velocity and acceleration limits times
+    :data:`TOPPRA_LIMIT_SAFETY` and its output is then verified on the samples: if a sampled
+    velocity or acceleration still exceeds a limit, time is stretched uniformly by the factor
+    ``k = max(velocity ratio, sqrt(acceleration ratio))`` (velocities scale by 1/k,
+    accelerations by 1/k^2), re-sampled and re-verified. The factor used is the profile's
+    ``time_scale`` (1 when the first result was within the limits).
+
+    Raises:
+        RetimingError: toppra found no parameterisation, or the samples still exceed the limits
+            after :data:`TOPPRA_RESCALE_ROUNDS` slow-downs.
     """
     import toppra
     import toppra.algorithm
@@ -160,27 +190,39 @@ def toppra_profile(
     if isinstance(segment, LineSegment):
         s, waypoints = segment.grid.s, segment.grid.q
     else:
-        s = np.linspace(0.0, 1.0, 5)
+        s = np.linspace(0.0, 1.0, TOPPRA_FREE_GRID_POINTS)
         waypoints = segment.joint_path(s)
     if np.allclose(waypoints, waypoints[0], atol=1e-12, rtol=0):  # nothing to move
         t = np.array([0.0])
         zero = np.zeros((1, 5))
         return Profile(t, waypoints[:1].copy(), zero, zero)
     path = toppra.SplineInterpolator(s, waypoints)
-    velocity = toppra.constraint.JointVelocityConstraint(
-        np.column_stack([-limits.velocity, limits.velocity])
-    )
-    acceleration = toppra.constraint.JointAccelerationConstraint(
-        np.column_stack([-limits.acceleration, limits.acceleration])
-    )
+    v_max = limits.velocity * TOPPRA_LIMIT_SAFETY
+    a_max = limits.acceleration * TOPPRA_LIMIT_SAFETY
+    velocity = toppra.constraint.JointVelocityConstraint(np.column_stack([-v_max, v_max]))
+    acceleration = toppra.constraint.JointAccelerationConstraint(np.column_stack([-a_max, a_max]))
     algorithm = toppra.algorithm.TOPPRA(
-        [velocity, acceleration], path, parametrizer="ParametrizeConstAccel"
+        [velocity, acceleration], path, gridpoints=s, parametrizer="ParametrizeConstAccel"
     )
     trajectory = algorithm.compute_trajectory(0.0, 0.0)
     if trajectory is None:
         raise RetimingError("toppra", "the path is not parameterisable under the limits")
-    t = sample_times(float(trajectory.duration), rate)
-    return Profile(t, trajectory(t), trajectory(t, 1), trajectory(t, 2))
+    duration = float(trajectory.duration)
+    scale = 1.0
+    for _ in range(TOPPRA_RESCALE_ROUNDS + 1):
+        t = sample_times(duration * scale, rate)
+        tau = np.minimum(t / scale, duration)  # time on toppra's own clock
+        qd, qdd = trajectory(tau, 1) / scale, trajectory(tau, 2) / scale**2
+        needed = max(
+            float(np.max(np.abs(qd).max(axis=0) / limits.velocity)),
+            math.sqrt(float(np.max(np.abs(qdd).max(axis=0) / limits.acceleration))),
+        )
+        if needed <= 1.0:
+            return Profile(t, trajectory(tau), qd, qdd, time_scale=scale)
+        scale *= needed * (1.0 + 1e-12)
+    raise RetimingError(
+        "toppra", f"the samples still exceed the limits after a slow-down by {scale:.6g}"
+    )
 
 
 def profile_stats(method: str, profile: Profile, limits: MotionLimits) -> ProfileStats:
@@ -211,6 +253,10 @@ def profile_stats(method: str, profile: Profile, limits: MotionLimits) -> Profil
         float(np.max(peak_v / limits.velocity)),
         float(np.max(peak_a / limits.acceleration)),
         tuple(violations),
+        profile.time_scale,
+        None
+        if profile.requested_duration is None
+        else bool(abs(profile.t[-1] - profile.requested_duration) <= DURATION_MATCH_TOLERANCE),
     )
 
 

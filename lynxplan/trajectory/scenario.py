@@ -28,9 +28,12 @@ from pathlib import Path
 from typing import Any, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
+from pydantic import Field, ValidationError, model_validator
+from pydantic_core import InitErrorDetails, PydanticCustomError
 
+from lynxplan.arm.geometry import JointLimits
 from lynxplan.arm.kinematics import forward_kinematics
+from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.scenario import Outcome, StrictModel, Units
 from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming
@@ -43,6 +46,7 @@ from lynxplan.trajectory.plan import (
     build_plan,
     segment_reports,
 )
+from lynxplan.trajectory.retime import TOPPRA_LIMIT_SAFETY
 from lynxplan.units import angle_factor, length_factor
 
 PerJoint = float | list[float]
@@ -144,6 +148,39 @@ class Scenario(StrictModel):
             )
         return self
 
+    @model_validator(mode="after")
+    def _configurations_within_joint_limits(self) -> Scenario:
+        """Reject a start or ``to_q`` outside the joint limits, naming the key path.
+
+        The check needs the file's angle unit, so it runs on the whole scenario; the error
+        carries the offending entry's own location (``start[1]``, ``segments[2].to_q[1]``).
+        """
+        factor = angle_factor(self.units.angle)
+        entries: list[tuple[tuple[int | str, ...], list[float]]] = [(("start",), self.start)]
+        entries += [
+            (("segments", i, "to_q"), entry.to_q)
+            for i, entry in enumerate(self.segments)
+            if entry.to_q is not None
+        ]
+        position = JointLimits().position
+        for loc, values in entries:
+            q = np.array(values) * factor
+            outside = (q < position[:, 0] - LIMIT_SNAP_TOLERANCE) | (
+                q > position[:, 1] + LIMIT_SNAP_TOLERANCE
+            )
+            for j in np.flatnonzero(outside):
+                low, high = position[j] / factor
+                message = (
+                    f"q{j + 1} = {values[j]:g} {self.units.angle} is outside its joint limits "
+                    f"[{low:g}, {high:g}] {self.units.angle}"
+                )
+                error = PydanticCustomError("joint_limit", message)  # type: ignore[misc]
+                raise ValidationError.from_exception_data(
+                    type(self).__name__,
+                    [InitErrorDetails(type=error, loc=(*loc, int(j)), input=values[j])],
+                )
+        return self
+
 
 def build(scenario: Scenario) -> Plan:
     """The scenario's plan (SI units)."""
@@ -169,6 +206,8 @@ def _report_json(
                     "velocity_ratio": s.velocity_ratio,
                     "acceleration_ratio": s.acceleration_ratio,
                     "violations": list(s.violations),
+                    "time_scale": s.time_scale,
+                    "duration_matched": s.duration_matched,
                 }
                 for name, s in comparison.segments[report.segment].stats.items()
             }
@@ -200,8 +239,11 @@ def _report_json(
             "ruckig applies to free segments only (it does not follow a Cartesian line).",
             "LSPB and toppra accelerations are piecewise constant: their sampled jerk is the "
             "acceleration step over the sample period (impulsive), not a limit violation.",
-            "toppra enforces the limits on its grid points; its sampled output may exceed them "
-            "slightly in between (see velocity_ratio / acceleration_ratio).",
+            f"toppra is given the limits times {TOPPRA_LIMIT_SAFETY} (it enforces them on its "
+            "grid points only); its samples are verified and, if still over a limit, time is "
+            "stretched uniformly by time_scale (velocity / k, acceleration / k^2).",
+            "ruckig_lspb_duration asks ruckig for the LSPB's duration; when that is shorter "
+            "than ruckig's jerk-limited minimum, ruckig takes longer (duration_matched false).",
         ]
     return out
 

@@ -83,6 +83,11 @@ INVALID = [
     ),
     (f"segments: [{{motion: free, {Q0}}}]\nplot: {{segment: 3}}", "", "plot.segment 3 does not"),
     ("segments: []", "segments", "at least 1 item"),
+    (
+        f"segments: [{{motion: free, {Q0}}}, {{motion: line, to_q: [0, 3, 0, 0, 0]}}]",
+        "segments[1].to_q[1]",
+        r"q2 = 3 rad is outside its joint limits \[0, 2.61799\] rad",
+    ),
 ]
 
 
@@ -93,6 +98,33 @@ def test_invalid_scenarios_name_the_key(
     with pytest.raises(ScenarioError, match=reason) as info:
         run_scenario(_write(tmp_path, body), None)
     assert info.value.location == location
+
+
+def test_configurations_outside_the_joint_limits_are_rejected(tmp_path: Path) -> None:
+    path = tmp_path / "deg.yaml"
+    head = "kind: trajectory\nunits: {angle: deg}\n"
+    path.write_text(
+        head + "start: [0, 0, 0, 0, 0]\nsegments: [{motion: free, to_q: [0, 200, 0, 0, 0]}]\n"
+    )
+    with pytest.raises(
+        ScenarioError, match=r"q2 = 200 deg is outside its joint limits \[0, 150\] deg"
+    ):
+        run_scenario(path, None)
+    path.write_text(
+        head + "start: [0, 0, 10, 0, 0]\nsegments: [{motion: free, to_q: [0, 0, 0, 0, 0]}]\n"
+    )
+    with pytest.raises(
+        ScenarioError, match=r"q3 = 10 deg is outside its joint limits \[-150, 0\]"
+    ) as info:
+        run_scenario(path, None)
+    assert info.value.location == "start[2]"
+    # On the limit itself is allowed (the report's free-motion example starts at q3 = 0).
+    path.write_text(
+        head
+        + "start: [0, 150, -150, 180, 180]\ncompare: false\n"
+        + "segments: [{motion: free, to_q: [0, 0, 0, 0, 0]}]\n"
+    )
+    assert run_scenario(path, None).ok
 
 
 def test_unreachable_target_names_the_segment(tmp_path: Path) -> None:
