@@ -8,11 +8,15 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import re
 import sys
 from collections.abc import Sequence
+from typing import Any
 
 from lynxplan import __version__
 from lynxplan.exceptions import LynxplanError
+
+_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
 COMMAND_MODULES = (
     "lynxplan.commands.arm",
@@ -25,7 +29,12 @@ COMMAND_MODULES = (
 
 
 class _Parser(argparse.ArgumentParser):
-    """ArgumentParser whose usage errors are one line and exit code 2."""
+    """ArgumentParser whose usage errors are one line and exit code 2, and which takes every
+    negative number (``-45``, ``-5.``, ``-1e-3``) as a value, never as an option."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = _NEGATIVE_NUMBER
 
     def error(self, message: str) -> None:  # type: ignore[override]
         sys.stderr.write(f"{self.prog}: error: {message}\n")
@@ -54,6 +63,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         code: int = args.handler(args)
     except LynxplanError as exc:
         sys.stderr.write(f"lynxplan: error: {exc}\n")
+        return 2
+    except OSError as exc:  # e.g. an output folder that cannot be created
+        where = f": {exc.filename}" if exc.filename else ""
+        sys.stderr.write(f"lynxplan: error: {exc.strerror or exc}{where}\n")
         return 2
     except KeyboardInterrupt:
         sys.stderr.write("lynxplan: interrupted\n")

@@ -70,10 +70,14 @@ class NotRigidTransformError(InputError):
     def __init__(self, deviation: float, tolerance: float, what: str = "pose") -> None:
         self.deviation = deviation
         self.tolerance = tolerance
-        super().__init__(
-            f"{what} is not a rigid transform: rotation deviates from orthonormal by "
-            f"{deviation:.3g} (at most {tolerance:.3g} is re-orthonormalised)"
-        )
+        if tolerance > 0:
+            detail = (
+                f"rotation deviates from orthonormal by {deviation:.3g} (at most "
+                f"{tolerance:.3g} is re-orthonormalised)"
+            )
+        else:
+            detail = f"off by {deviation:.3g}"
+        super().__init__(f"{what} is not a rigid transform: {detail}")
 
 
 class KinematicsError(LynxplanError):

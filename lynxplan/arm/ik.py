@@ -212,7 +212,7 @@ def ik_kernel(
         _orthonormalise(a_t, n_t, o_t, approach_only)
 
         # Arm plane: radial unit vector towards the tool point (front branch).
-        rho = math.sqrt(px * px + py * py)
+        rho = math.hypot(px, py)  # hypot: no overflow for huge inputs
         if rho > BASE_AXIS_TOLERANCE_K:
             c1, s1 = px / rho, py / rho
         else:
@@ -233,12 +233,14 @@ def ik_kernel(
         # Wrist centre in plane coordinates (radial r, height z).
         r_w = c1 * px + s1 * py - d5 * s234
         z_w = pz + d5 * c234
-        dist = math.sqrt(r_w * r_w + z_w * z_w)
-        if dist > a2 + a3:
+        dist = math.hypot(r_w, z_w)
+        if not math.isfinite(dist):
+            miss_out[k] = math.inf
+        elif dist > a2 + a3:
             miss_out[k] = dist - (a2 + a3)
         elif dist < abs(a2 - a3):
             miss_out[k] = abs(a2 - a3) - dist
-        if miss_out[k] > REACH_TOLERANCE_K:
+        if not miss_out[k] <= REACH_TOLERANCE_K:  # also catches an overflowed (inf/NaN) miss
             status_out[k] = IkStatus.OUT_OF_REACH
             _mark_unsolved(k, q_out, within_out, residual_out)
             continue

@@ -39,6 +39,7 @@ DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
 _STRUCTURE_TOLERANCE = 1e-9
 _ZEROS = np.zeros(5)
 _ZEROS.setflags(write=False)
+_BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
 def default_urdf_path() -> Path:
@@ -259,6 +260,10 @@ class Arm:
             params[3] = limit_tolerance
         _ik.ik_single_kernel(pose, reference, params, flags, rows, scalars)
         residual, status, miss, deviation, selected = scalars.tolist()
+        if int(status) == _ik.IkStatus.NOT_RIGID and np.abs(pose[3] - _BOTTOM_ROW).max() > 1e-9:
+            raise NotRigidTransformError(
+                float(np.abs(pose[3] - _BOTTOM_ROW).max()), 0.0, "pose (last row must be 0 0 0 1)"
+            )
         _raise_for_status(int(status), miss, deviation)
         if strict and residual > orientation_tolerance:
             raise OrientationNotReachableError(residual, orientation_tolerance)

@@ -17,6 +17,7 @@ class Expectations(StrictModel):
     min_volume: PositiveFloat | None = Field(None, description="Volume at least this.")
     max_volume: PositiveFloat | None = Field(None, description="Volume at most this.")
     max_reach: PositiveFloat | None = Field(None, description="Sampled reach at most this.")
+    min_reach: PositiveFloat | None = Field(None, description="Sampled reach at least this.")
 
 
 class Scenario(StrictModel):
@@ -77,6 +78,8 @@ def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Out
         failed.append(f"max_volume: {summary['volume']:.4g} > {expect.max_volume:g} {unit}^3")
     if expect.max_reach is not None and summary["max_reach"] > expect.max_reach:
         failed.append(f"max_reach: {summary['max_reach']:.6g} > {expect.max_reach:g} {unit}")
+    if expect.min_reach is not None and summary["max_reach"] < expect.min_reach:
+        failed.append(f"min_reach: {summary['max_reach']:.6g} < {expect.min_reach:g} {unit}")
     text = (
         f"workspace of {arm.urdf_path.name}: {estimate.samples:,} samples, volume "
         f"{summary['volume']:.4g} {unit}^3 (planar cell {summary['grid_cell']:g} {unit}; voxel "

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
+from lynxplan.exceptions import LynxplanError, ScenarioError
 from lynxplan.runner import run_scenario
 
 
@@ -19,7 +20,12 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the scenario; exit 0 when every expectation holds, 1 otherwise."""
-    outcome = run_scenario(args.scenario, args.out, quick=args.quick)
+    try:
+        outcome = run_scenario(args.scenario, args.out, quick=args.quick)
+    except ScenarioError:
+        raise
+    except LynxplanError as exc:  # a run-time problem: say which file it came from
+        raise ScenarioError(args.scenario, "", str(exc)) from exc
     print(outcome.summary)
     if not outcome.ok:
         print("failed expectations:")

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import math
 from pathlib import Path
 from typing import Any
 
@@ -31,19 +32,20 @@ def handle(args: argparse.Namespace) -> int:
     from lynxplan.exceptions import InputError
     from lynxplan.scenario import Units
 
+    if args.samples < 1:
+        raise InputError(f"workspace --samples: must be at least 1. Got: {args.samples}")
+    for option, value, smallest in (("--cell", args.cell, 0.1), ("--voxel", args.voxel, 0.1)):
+        if not (math.isfinite(value) and value >= smallest):
+            raise InputError(f"workspace {option}: must be at least {smallest} mm. Got: {value}")
     mm_to_unit = 1e-3 / LENGTH_UNITS[args.units]
-    try:
-        scenario = workspace_scenario.Scenario(
-            kind="workspace",
-            samples=args.samples,
-            cell=args.cell * mm_to_unit,
-            voxel_size=args.voxel * mm_to_unit,
-            seed=args.seed,
-            units=Units(length=args.units, angle="deg"),
-        )
-    except ValueError as exc:
-        reason = str(exc).splitlines()[1:3]
-        raise InputError("workspace: " + " ".join(r.strip() for r in reason)) from None
+    scenario = workspace_scenario.Scenario(
+        kind="workspace",
+        samples=args.samples,
+        cell=args.cell * mm_to_unit,
+        voxel_size=args.voxel * mm_to_unit,
+        seed=args.seed,
+        units=Units(length=args.units, angle="deg"),
+    )
     out = Path(args.out)
     out.resolve().parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory(prefix=".workspace-", dir=out.resolve().parent) as staging:

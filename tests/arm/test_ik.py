@@ -285,3 +285,32 @@ def test_round_trip_property_any_configuration(q_list: list[float]) -> None:
     batch = solve_ik_batch(T, limit_tolerance=0.0)
     assert batch.status[0] == IkStatus.OK
     assert_branches_reproduce(batch.q, T[None])
+
+
+def test_bottom_row_error_is_named(arm) -> None:
+    T = arm.fk(np.radians([100, 50, -60, 40, 20]))
+    T[3, 3] = 2.0
+    with pytest.raises(NotRigidTransformError, match=r"last row must be 0 0 0 1\) .* off by 1"):
+        arm.ik(T)
+
+
+def test_huge_translation_is_out_of_reach_not_garbage(arm) -> None:
+    T = arm.fk(np.zeros(5))
+    T[0, 3] = 1e160
+    with pytest.raises(UnreachablePoseError, match="out of reach"):
+        arm.ik(T)
+    assert solve_ik_batch(T).status[0] == IkStatus.OUT_OF_REACH
+
+
+def test_two_solutions_within_limits_nearest_and_report_rule_differ(arm) -> None:
+    # On q1 = 0 the back branch (q1 = 180 deg) is within limits too.
+    q = np.radians([0, 100, -40, 120, 0])
+    result = arm.ik(arm.fk(q))
+    within = [s for s in result.solutions if s.within_limits]
+    assert len(within) == 2
+    other = next(s for s in within if not np.allclose(s.q, q, atol=1e-9))
+    np.testing.assert_allclose(arm.ik(arm.fk(q), q_reference=q).q, q, atol=1e-12)
+    np.testing.assert_allclose(arm.ik(arm.fk(q), q_reference=other.q).q, other.q, atol=1e-12)
+    report = arm.ik(arm.fk(q), q_reference=other.q, select="report").q
+    assert report[1] >= 0 and report[2] <= 0
+    np.testing.assert_allclose(report, q, atol=1e-12)  # the report's rule ignores the reference

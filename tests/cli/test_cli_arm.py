@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import re
 from pathlib import Path
 
 import numpy as np
@@ -65,6 +66,11 @@ def test_ik_without_all_lists_only_solutions_within_limits(capsys) -> None:
         (("ik", "--pose", "[[1,0,0,5],[0,1,0,0],[0,0,1,0]]"), "out of reach"),
         (("ik", "--pose", O2_POSE, "--units", "in", "--strict"), "exceeds the strict tolerance"),
         (("run", "/nonexistent/scenario.yaml"), "cannot read file"),
+        (("workspace", "--samples", "0"), "--samples: must be at least 1"),
+        (("workspace", "--cell", "-3"), "--cell: must be at least 0.1 mm. Got: -3.0"),
+        (("workspace", "--voxel", "1e-9"), "--voxel: must be at least 0.1 mm"),
+        (("workspace", "--samples", "100", "--out", "/dev/null/x"), "File exists: /dev/null"),
+        (("bench", "--section", "nope"), "invalid choice: 'nope'"),
     ],
 )
 def test_bad_input_is_one_line_and_nonzero(capsys, args: tuple[str, ...], message: str) -> None:
@@ -75,7 +81,7 @@ def test_bad_input_is_one_line_and_nonzero(capsys, args: tuple[str, ...], messag
     err = capsys.readouterr().err
     assert code != 0
     assert err.count("\n") == 1 and "Traceback" not in err
-    assert pytest.importorskip("re").search(message, err), err
+    assert re.search(message, err), err
 
 
 def test_run_workspace_scenario_quick(capsys, tmp_path: Path) -> None:
@@ -136,3 +142,34 @@ def test_workspace_command_writes_plots_and_json(capsys, tmp_path: Path) -> None
         "workspace.json",
     ):
         assert (tmp_path / "w" / name).stat().st_size > 400
+
+
+def test_every_negative_number_form_is_a_value(capsys) -> None:
+    code, out, _ = run_cli(capsys, "fk", "-1e-3", "-5.", "-.5", "-0", "0", "--json")
+    assert code == 0
+    expected = np.array(json.loads(out)["T"])
+    from lynxplan.arm import forward_kinematics
+
+    np.testing.assert_allclose(expected, forward_kinematics(np.array([-1e-3, -5.0, -0.5, 0, 0])))
+
+
+def test_duplicate_yaml_key_is_rejected(capsys, tmp_path: Path) -> None:
+    scenario = tmp_path / "dup.yaml"
+    scenario.write_text("kind: workspace\nsamples: 10\nsamples: 20\n")
+    code, _, err = run_cli(capsys, "validate", str(scenario))
+    assert code == 2 and "line 3: invalid YAML: duplicate key 'samples'" in err
+
+
+def test_run_time_error_names_the_scenario_file(capsys, tmp_path: Path) -> None:
+    scenario = tmp_path / "far.yaml"
+    scenario.write_text("kind: parallel_ik\npose: [2000, 180, 30]\n")
+    code, _, err = run_cli(capsys, "run", str(scenario), "--quick", "--out", str(tmp_path / "o"))
+    assert code == 2 and f"scenario {scenario}" in err and "leg" in err
+
+
+def test_bench_smoke_json(capsys) -> None:
+    code, out, _ = run_cli(capsys, "bench", "--section", "parallel", "--quick", "--json")
+    assert code == 0
+    figures = json.loads(out)["figures"]
+    assert figures and all(f["section"] == "parallel" for f in figures)
+    assert all(np.isfinite(f["value"]) and f["value"] > 0 for f in figures)
