@@ -186,7 +186,9 @@ def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Out
     path_points = problem.path.points
     axis_distance = line_distance_to_base_axis(path_points[0, :3], path_points[-1, :3])
     conditions = [c.value for c in singular_conditions(problem.task, arm.geometry)]
-    failures = check_expectations(scenario.expect, metrics, axis_distance, lf)
+    failures = check_expectations(
+        scenario.expect, metrics, axis_distance, lf, scenario.units.length
+    )
     if out_dir is not None:
         write_report(out_dir, scenario, problem, runs, metrics, axis_distance, conditions)
         if not quick:
@@ -198,9 +200,13 @@ def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Out
 
 
 def check_expectations(
-    expect: Expect, metrics: dict[Strategy, RunMetrics], axis_distance: float, lf: float
+    expect: Expect,
+    metrics: dict[Strategy, RunMetrics],
+    axis_distance: float,
+    lf: float,
+    unit: str = "m",
 ) -> tuple[str, ...]:
-    """Human-readable failed expectations."""
+    """Human-readable failed expectations; ``lf`` metres per ``unit`` (the file's length unit)."""
     by_name = {m.strategy: m for m in metrics.values()}
     failures = []
     if expect.pinv_exceeds_speed_limit is not None:
@@ -223,8 +229,9 @@ def check_expectations(
         limit = expect.max_distance_to_singularity * lf
         if axis_distance > limit:
             failures.append(
-                f"max_distance_to_singularity: the line passes {axis_distance / lf:.6g} from the "
-                f"base axis, more than {expect.max_distance_to_singularity:.6g}"
+                f"max_distance_to_singularity: the line passes {axis_distance / lf:.6g} "
+                f"{unit} from the base axis, more than "
+                f"{expect.max_distance_to_singularity:.6g} {unit}"
             )
     return tuple(failures)
 

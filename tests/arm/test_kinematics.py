@@ -133,3 +133,12 @@ def test_top_level_load_arm_is_the_shared_default() -> None:
 
     assert lynxplan.load_arm() is load_arm()
     np.testing.assert_allclose(lynxplan.load_arm().fk(np.zeros(5))[:3, 3], [0.333375, 0, -0.085725])
+
+
+def test_default_limits_match_the_urdf(arm) -> None:
+    """JointLimits() (used where no arm is at hand) must not drift from the URDF."""
+    from lynxplan.arm import JointLimits
+
+    defaults = JointLimits()
+    np.testing.assert_allclose(defaults.position, arm.limits.position, atol=1e-12)
+    np.testing.assert_allclose(defaults.velocity, arm.limits.velocity, atol=0)

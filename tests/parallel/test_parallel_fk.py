@@ -6,7 +6,7 @@ import math
 
 import numpy as np
 import pytest
-from hypothesis import given, settings
+from hypothesis import assume, given, settings
 from hypothesis import strategies as st
 
 from lynxplan.exceptions import (
@@ -95,8 +95,7 @@ def test_assembly_mode_counts_on_random_configurations_match_scan() -> None:
 )
 def test_ik_then_fk_recovers_the_pose(pose: tuple[float, float, float], mode: int) -> None:
     ik = solve_ik_batch(np.array(pose))
-    if not ik.reachable.all():
-        return
+    assume(ik.reachable.all())  # ~20 % of the box is reachable: hypothesis draws more
     result = solve_fk(ik.angles[0, mode])
     assert np.min(pose_distance(result.poses, np.array(pose), GEOMETRY)) < POSE_ATOL
 
