@@ -33,7 +33,7 @@ def test_failed_expectation_is_reported(tmp_path: Path) -> None:
     path.write_text(text)
     outcome = run_scenario(path, None, quick=True)
     assert outcome.failed_expectations == (
-        "max_distance_to_singularity: the line passes 1 from the base axis, more than 0.5",
+        "max_distance_to_singularity: the line passes 1 mm from the base axis, more than 0.5 mm",
     )
 
 
