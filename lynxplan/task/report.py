@@ -207,6 +207,8 @@ def _comparison(result: TaskResult) -> dict[str, Any] | None:
                 "velocity_ratio": stats.velocity_ratio,
                 "acceleration_ratio": stats.acceleration_ratio,
                 "violations": list(stats.violations),
+                "time_scale": stats.time_scale,
+                "duration_matched": stats.duration_matched,
             }
         rows.append(row)
     return {
