@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import shutil
-import subprocess
 from pathlib import Path
 
 import numpy as np
 import pytest
+from browser import CHROMIUM, neutral, orange, screenshot
 
 from lynxplan.collision import SphereObstacle, axis_aligned_box
 from lynxplan.viz import export_html, tilted_plane
 
-CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
 WIDTH, HEIGHT = 800, 600
 #: meshcat's default perspective camera: vertical field of view, in [deg].
 CAMERA_FOV_DEG = 75.0
@@ -38,28 +36,10 @@ def _project(point: np.ndarray) -> tuple[float, float]:
 
 
 def _screenshot(html: Path, png: Path, profile: Path) -> np.ndarray:
-    from PIL import Image
-
-    command = [
-        str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--use-angle=swiftshader",
-        "--enable-unsafe-swiftshader", "--no-first-run", "--disable-background-networking",
-        "--disable-component-update", "--disable-sync", f"--user-data-dir={profile}",
-        "--virtual-time-budget=8000", f"--window-size={WIDTH},{HEIGHT}",
-        f"--screenshot={png}", html.as_uri(),
-    ]  # fmt: skip
-    subprocess.run(command, check=True, capture_output=True, timeout=120)
-    return np.asarray(Image.open(png).convert("RGB"), dtype=int)
+    return screenshot(html, png, profile, WIDTH, HEIGHT)
 
 
-def _orange(pixels: np.ndarray) -> np.ndarray:
-    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
-    return (r > 150) & (r - b > 80) & (g > 50) & (g < r - 30)
-
-
-def _neutral(pixels: np.ndarray) -> np.ndarray:
-    """Grey, black or aluminium (the arm); meshcat's sky-blue background has b - r >= 87."""
-    r, g, b = pixels[..., 0], pixels[..., 1], pixels[..., 2]
-    return (np.abs(r - b) < 40) & (np.abs(r - g) < 40)
+_orange, _neutral = orange, neutral
 
 
 def _window(mask: np.ndarray, centre: tuple[float, float], half: int) -> np.ndarray:
