@@ -34,9 +34,12 @@ from lynxplan.exceptions import NonFiniteInputError, ShapeError
 
 BRANCH_NAMES = ("front/elbow-up", "front/elbow-down", "back/elbow-up", "back/elbow-down")
 TWO_PI = 2.0 * math.pi
+#: IEEE-safe fast-math flags: fused multiply-add and division by reciprocal (rounding differs
+#: by an ulp; no assumptions about NaN, infinity or signed zeros, which the kernels rely on).
+_FAST = {"contract", "arcp"}
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _dot3(u: np.ndarray, v: np.ndarray) -> float:
     """Dot product of two 3-vectors (numba's ``@`` calls BLAS: slow for 3 elements)."""
     return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
@@ -75,7 +78,7 @@ class IkBatch(NamedTuple):
     """Deviation of each pose's rotation from orthonormal, ``max |R^T R - I|``, shape (N,)."""
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: bool) -> None:
     """Gram-Schmidt from the approach axis, in place: a normalised; unless ``approach_only``,
     n made orthogonal to a and normalised, and o = a x n."""
@@ -95,7 +98,7 @@ def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: 
     o[2] = a[0] * n[1] - a[1] * n[0]
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _mark_unsolved(
     k: int, q_out: np.ndarray, within_out: np.ndarray, residual_out: np.ndarray
 ) -> None:
@@ -107,7 +110,7 @@ def _mark_unsolved(
             q_out[k, b, j] = np.nan
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
     if lo <= x <= hi:
@@ -124,7 +127,7 @@ def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float
     return (y, False) if above <= below else (y - TWO_PI, False)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _angle_between_frames(
     n_t: np.ndarray,
     o_t: np.ndarray,
@@ -147,7 +150,7 @@ def _angle_between_frames(
     return atan2(sine, cosine)
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, fastmath=_FAST)
 def ik_kernel(
     T: np.ndarray,
     q_ref: np.ndarray,
@@ -190,6 +193,11 @@ def ik_kernel(
             _mark_unsolved(k, q_out, within_out, residual_out)
             continue
         px, py, pz = T[k, 0, 3], T[k, 1, 3], T[k, 2, 3]
+        if max(abs(px), abs(py), abs(pz)) > FAR_AWAY_K:  # keeps squares below overflow
+            status_out[k] = IkStatus.OUT_OF_REACH
+            miss_out[k] = max(abs(px), abs(py), abs(pz)) - (a2 + a3 + d5)
+            _mark_unsolved(k, q_out, within_out, residual_out)
+            continue
         for i in range(3):
             a_t[i] = T[k, i, 2]
             n_t[i] = T[k, i, 0]
@@ -212,7 +220,7 @@ def ik_kernel(
         _orthonormalise(a_t, n_t, o_t, approach_only)
 
         # Arm plane: radial unit vector towards the tool point (front branch).
-        rho = math.hypot(px, py)  # hypot: no overflow for huge inputs
+        rho = math.sqrt(px * px + py * py)
         if rho > BASE_AXIS_TOLERANCE_K:
             c1, s1 = px / rho, py / rho
         else:
@@ -233,10 +241,8 @@ def ik_kernel(
         # Wrist centre in plane coordinates (radial r, height z).
         r_w = c1 * px + s1 * py - d5 * s234
         z_w = pz + d5 * c234
-        dist = math.hypot(r_w, z_w)
-        if not math.isfinite(dist):
-            miss_out[k] = math.inf
-        elif dist > a2 + a3:
+        dist = math.sqrt(r_w * r_w + z_w * z_w)
+        if dist > a2 + a3:
             miss_out[k] = dist - (a2 + a3)
         elif dist < abs(a2 - a3):
             miss_out[k] = abs(a2 - a3) - dist
@@ -312,6 +318,8 @@ def ik_kernel(
 RIGIDITY_REPAIR_TOLERANCE_K = RIGIDITY_REPAIR_TOLERANCE
 BASE_AXIS_TOLERANCE_K = BASE_AXIS_TOLERANCE
 REACH_TOLERANCE_K = REACH_TOLERANCE
+#: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
+FAR_AWAY_K = 1e9
 
 _DEFAULT_GEOMETRY = ArmGeometry()
 _DEFAULT_LIMITS = JointLimits()
