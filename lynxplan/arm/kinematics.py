@@ -17,7 +17,7 @@ from lynxplan.exceptions import NonFiniteInputError, ShapeError
 _DEFAULT_GEOMETRY = ArmGeometry()
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, fastmath={"contract"})  # FMA: same results to an ulp
 def fk_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -> None:
     """Write the tool transforms of the configurations ``q`` (N, 5) into ``out`` (N, 4, 4)."""
     for k in range(q.shape[0]):
