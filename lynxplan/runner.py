@@ -5,6 +5,8 @@ from __future__ import annotations
 import os
 import shutil
 import tempfile
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 from lynxplan.exceptions import LynxplanError
@@ -25,6 +27,18 @@ def run_scenario(path: str | Path, out_dir: str | Path | None, *, quick: bool = 
     module, scenario = load_scenario(path)
     if out_dir is None:
         return module.run(scenario, None, quick=quick)
+    with staged_outputs(out_dir) as staging:
+        return module.run(scenario, staging, quick=quick)
+
+
+@contextmanager
+def staged_outputs(out_dir: str | Path) -> Iterator[Path]:
+    """A staging folder next to ``out_dir`` whose files move into ``out_dir`` only if the block
+    succeeds; the staging folder is always removed.
+
+    Raises:
+        LynxplanError: if the folder cannot be created.
+    """
     out = Path(out_dir)
     parent = out.resolve().parent
     try:
@@ -33,11 +47,10 @@ def run_scenario(path: str | Path, out_dir: str | Path | None, *, quick: bool = 
     except OSError as exc:
         raise LynxplanError(f"cannot create output folder {out}: {exc.strerror}") from exc
     try:
-        outcome = module.run(scenario, staging, quick=quick)
+        yield staging
         commit_outputs(staging, out)
     finally:
         shutil.rmtree(staging, ignore_errors=True)
-    return outcome
 
 
 def commit_outputs(staging: Path, out: Path) -> None:

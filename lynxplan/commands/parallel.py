@@ -116,22 +116,17 @@ def handle_workspace(args: argparse.Namespace) -> int:
     """Compute the workspace, write its PNG, print area and point count."""
     from lynxplan.parallel.plots import plot_workspace
     from lynxplan.parallel.workspace import constant_orientation_workspace
+    from lynxplan.runner import staged_outputs
 
     alpha_deg = parse_finite(args.alpha, "--alpha")
     step = parse_finite(args.step, "--step")
     mode = _mode_argument(args.mode)
     workspace = constant_orientation_workspace(math.radians(alpha_deg), step=step * 1e-3, mode=mode)
-    out = Path(args.out)
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as exc:
-        raise InputError(f"--out: cannot create folder {out}: {exc.strerror}") from exc
     suffix = "" if mode is None else f"_mode{mode + 1}"
-    png = plot_workspace(
-        workspace,
-        out / f"parallel_workspace_alpha{alpha_deg:g}{suffix}.png",
-        loci_mode=0 if mode is None else mode,
-    )
+    name = f"parallel_workspace_alpha{alpha_deg:g}{suffix}.png"
+    with staged_outputs(args.out) as staging:
+        plot_workspace(workspace, staging / name, loci_mode=0 if mode is None else mode)
+    png = Path(args.out) / name
     if args.json:
         print_json({"area_mm2": workspace.area_mm2, "points": workspace.points})
         return 0

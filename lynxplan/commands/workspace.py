@@ -7,7 +7,7 @@ import math
 from pathlib import Path
 from typing import Any
 
-from lynxplan.runner import commit_outputs
+from lynxplan.runner import staged_outputs
 from lynxplan.units import LENGTH_UNITS
 
 
@@ -26,8 +26,6 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the workspace analysis with the command-line settings."""
-    import tempfile
-
     from lynxplan.arm import workspace_scenario
     from lynxplan.exceptions import InputError
     from lynxplan.scenario import Units
@@ -47,11 +45,9 @@ def handle(args: argparse.Namespace) -> int:
         units=Units(length=args.units, angle="deg"),
     )
     out = Path(args.out)
-    out.resolve().parent.mkdir(parents=True, exist_ok=True)
-    with tempfile.TemporaryDirectory(prefix=".workspace-", dir=out.resolve().parent) as staging:
-        outcome = workspace_scenario.run(scenario, Path(staging))
-        summary = (Path(staging) / "workspace.json").read_text(encoding="utf-8")
-        commit_outputs(Path(staging), out)
+    with staged_outputs(out) as staging:
+        outcome = workspace_scenario.run(scenario, staging)
+        summary = (staging / "workspace.json").read_text(encoding="utf-8")
     if args.json:
         print(summary, end="")
     else:
