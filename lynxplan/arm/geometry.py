@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -77,5 +76,3 @@ JOINT_NAMES = ("q1", "q2", "q3", "q4", "q5")
 TOOL_FRAME = "tool"
 #: Names of DH frames 1-4 in the URDF.
 DH_FRAMES = ("dh_frame_1", "dh_frame_2", "dh_frame_3", "dh_frame_4")
-#: Half-turn, used when switching the base branch.
-PI = math.pi
