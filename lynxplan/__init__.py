@@ -14,14 +14,19 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm
+    from lynxplan.scenarios.runner import run_scenario
 
-__all__ = ["Arm", "LynxplanError", "__version__", "load_arm"]
+__all__ = ["Arm", "LynxplanError", "__version__", "load_arm", "run_scenario"]
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy attributes: ``lynxplan.load_arm`` and ``lynxplan.Arm``."""
+    """Lazy attributes: ``lynxplan.load_arm``, ``lynxplan.Arm``, ``lynxplan.run_scenario``."""
     if name in ("load_arm", "Arm"):
         from lynxplan.arm import model
 
         return getattr(model, name)
+    if name == "run_scenario":
+        from lynxplan.scenarios.runner import run_scenario
+
+        return run_scenario
     raise AttributeError(f"module 'lynxplan' has no attribute {name!r}")
