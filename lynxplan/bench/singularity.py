@@ -24,13 +24,13 @@ def run(quick: bool) -> list[Figure]:
     """Measure µs per step for each strategy; ``quick`` shortens the Python reference runs."""
     from lynxplan.arm import load_arm
     from lynxplan.scenarios import load_scenario
+    from lynxplan.scenarios.singularity import Scenario, build_problem
     from lynxplan.singularity import (
         STRATEGY_NAMES,
         Strategy,
         run_reference,
         run_resolved_rate,
     )
-    from lynxplan.scenarios.singularity import Scenario, build_problem
 
     scenario = load_scenario(_SCENARIO).scenario
     problem = build_problem(cast(Scenario, scenario))

@@ -11,6 +11,7 @@ from __future__ import annotations
 import tempfile
 import time
 from pathlib import Path
+from typing import Any
 
 from lynxplan.bench import Figure, median_seconds
 
@@ -37,9 +38,9 @@ def run(quick: bool) -> list[Figure]:
             lambda: run_scenario(path, out, quick=True, force=True), repeats=repeats
         )
         load = median_seconds(lambda: load_scenario(path), repeats=repeats)
-        scenario = load_scenario(path).scenario
-        setup = resolve(scenario)  # type: ignore[arg-type]
-        runs = [execute(scenario, setup).stage_seconds  # type: ignore[arg-type] for _ in range(repeats)]
+        scenario: Any = load_scenario(path).scenario
+        setup = resolve(scenario)
+        runs = [execute(scenario, setup).stage_seconds for _ in range(repeats)]
         stages = {name: sorted(r[name] for r in runs)[len(runs) // 2] for name in runs[0]}
         figures = [
             Figure(

@@ -122,7 +122,9 @@ def _resolve(key: str, metrics: Mapping[str, Quantity]) -> tuple[str, str | None
         return key, prefix_op
     if prefix_op is not None and key[4:] in metrics:
         return key[4:], prefix_op
-    numeric = [m for m, q in metrics.items() if q not in ("bool", "flags") and m[:4] not in _PREFIXES]
+    numeric = [
+        m for m, q in metrics.items() if q not in ("bool", "flags") and m[:4] not in _PREFIXES
+    ]
     valid = sorted({*metrics, *(f"max_{m}" for m in numeric), *(f"min_{m}" for m in numeric)})
     shown = ", ".join(valid) if valid else "none (this kind measures no metric)"
     raise ValueError(f"unknown expectation {key!r}; valid: {shown}")
@@ -185,7 +187,9 @@ def _parse_equals(
     key: str, metric: str, quantity: Quantity, text: Mapping[str, Any], units: Units
 ) -> ParsedExpectation:
     if set(text) - {"equals", "tolerance"} or "equals" not in text:
-        raise ValueError(f"{key} takes {{equals: value, tolerance: number}}, got {_short(dict(text))}")
+        raise ValueError(
+            f"{key} takes {{equals: value, tolerance: number}}, got {_short(dict(text))}"
+        )
     factor = _factor("", quantity, units, text)
     try:
         wanted = np.asarray(text["equals"], dtype=float) * factor

@@ -29,7 +29,6 @@ from lynxplan.units import angle_factor, length_factor
 NAME = "parallel_ik"
 
 
-
 class GeometrySpec(StrictModel):
     """Robot dimensions in the file's length unit (defaults: the report's robot, in mm)."""
 

@@ -30,7 +30,6 @@ NAME = "parallel_workspace"
 MAX_GRID_CELLS = 20_000_000
 
 
-
 class Region(StrictModel):
     """Scanned region in the file's length unit (default: the report's, in mm)."""
 
@@ -75,8 +74,10 @@ class Input(ScenarioModel):
             "geometry": self.geometry.si(self.units),
             "alphas": [a * angle for a in self.alphas],
             "step": self.step * length,
-            "region": {"x": [v * length for v in self.region.x],
-                       "y": [v * length for v in self.region.y]},
+            "region": {
+                "x": [v * length for v in self.region.x],
+                "y": [v * length for v in self.region.y],
+            },
             "mode": self.mode,
             "loci_mode": self.loci_mode,
         }
@@ -105,7 +106,8 @@ def run(scenario: Input) -> KindOutput:
         for alpha, w in zip(si["alphas"], workspaces, strict=True)
     ]
     text = ", ".join(
-        f"alpha {a:g}: {w.area_mm2:.0f} mm^2" for a, w in zip(scenario.alphas, workspaces, strict=True)
+        f"alpha {a:g}: {w.area_mm2:.0f} mm^2"
+        for a, w in zip(scenario.alphas, workspaces, strict=True)
     )
     return KindOutput(
         {"area": areas},
@@ -123,7 +125,12 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
     geometry, workspaces, rows = output.payload
     length = length_factor(scenario.units.length)
     table = [
-        {"alpha": alpha, "area": r["area"] / length**2, "area_mm2": w.area_mm2, "points": r["points"]}
+        {
+            "alpha": alpha,
+            "area": r["area"] / length**2,
+            "area_mm2": w.area_mm2,
+            "points": r["points"],
+        }
         for alpha, r, w in zip(scenario.alphas, rows, workspaces, strict=True)
     ]
     write_json(out_dir / "parallel_workspace.json", {"workspaces": table})
@@ -134,6 +141,8 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
 
     for alpha, workspace in zip(scenario.alphas, workspaces, strict=True):
         name = f"parallel_workspace_alpha{alpha:g}.png"
-        plot_workspace(workspace, out_dir / name, geometry, loci_mode=mode_index(scenario.loci_mode))
+        plot_workspace(
+            workspace, out_dir / name, geometry, loci_mode=mode_index(scenario.loci_mode)
+        )
         written.append(name)
     return written

@@ -76,7 +76,9 @@ def load_scenario(source: str | Path | Mapping[str, Any]) -> LoadedScenario:
     return validate(read_source(source))
 
 
-def check_expectations(scenario: ScenarioModel, output: KindOutput) -> tuple[ExpectationResult, ...]:
+def check_expectations(
+    scenario: ScenarioModel, output: KindOutput
+) -> tuple[ExpectationResult, ...]:
     """Evaluate the kind's default expectations and the file's ``expect:`` block."""
     block = {**type(scenario).default_expect, **scenario.expect}
     parsed = parse_expectations(block, type(scenario).metrics, scenario.units)
@@ -94,8 +96,13 @@ def check_expectations(scenario: ScenarioModel, output: KindOutput) -> tuple[Exp
     return tuple(results)
 
 
-def execute(loaded: LoadedScenario, out_dir: str | Path | None = None, *, quick: bool = False,
-            force: bool = False) -> Result:
+def execute(
+    loaded: LoadedScenario,
+    out_dir: str | Path | None = None,
+    *,
+    quick: bool = False,
+    force: bool = False,
+) -> Result:
     """Run a loaded scenario; write its outputs (all or nothing) into ``out_dir`` if given."""
     from lynxplan.scenarios.outputs import staged_outputs
     from lynxplan.scenarios.report import write_json

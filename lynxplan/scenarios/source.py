@@ -70,7 +70,10 @@ class _UniqueKeyLoader(yaml.SafeLoader):
                 duplicate = key in seen
             except TypeError:
                 raise yaml.constructor.ConstructorError(
-                    None, None, f"a key must be a scalar, not {type(key).__name__}", key_node.start_mark
+                    None,
+                    None,
+                    f"a key must be a scalar, not {type(key).__name__}",
+                    key_node.start_mark,
                 ) from None
             if duplicate:
                 raise yaml.constructor.ConstructorError(

@@ -265,7 +265,6 @@ class Input(ScenarioModel):
     compare: bool = Field(True, description="Run the ruckig and toppra comparisons.")
     outputs: OutputsEntry = Field(default_factory=OutputsEntry)
 
-
     @model_validator(mode="after")
     def _route_names_exist(self) -> Self:
         from lynxplan.exceptions import ScenarioValueError
@@ -310,7 +309,11 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
     result = output.payload
     samples = result.samples
     write_trajectory_csv(
-        out_dir / "trajectory.csv", samples.t, samples.q, samples.qd, samples.qdd,
+        out_dir / "trajectory.csv",
+        samples.t,
+        samples.q,
+        samples.qd,
+        samples.qdd,
         samples.tool[:, :3, 3],
     )
     written = ["trajectory.csv"]

@@ -297,7 +297,11 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
 
     plan, samples, comparison = output.payload
     write_trajectory_csv(
-        out_dir / "trajectory.csv", samples.t, samples.q, samples.qd, samples.qdd,
+        out_dir / "trajectory.csv",
+        samples.t,
+        samples.q,
+        samples.qd,
+        samples.qdd,
         samples.tool[:, :3, 3],
     )
     if quick:

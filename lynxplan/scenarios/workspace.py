@@ -94,9 +94,12 @@ def run(scenario: Input) -> KindOutput:
         f"{estimate.max_reach / scale:.4f} {unit}, z from {estimate.z_range[0] / scale:.3f} to "
         f"{estimate.z_range[1] / scale:.3f} {unit}."
     )
-    details = {"samples": estimate.samples, "grid_cell": estimate.envelope.cell,
-               "voxel_size": estimate.voxel_size,
-               "report_grid_points": None if grid is None else int(grid.shape[0])}
+    details = {
+        "samples": estimate.samples,
+        "grid_cell": estimate.envelope.cell,
+        "voxel_size": estimate.voxel_size,
+        "report_grid_points": None if grid is None else int(grid.shape[0]),
+    }
     return KindOutput(metrics, summary, details, payload=(estimate, grid))
 
 

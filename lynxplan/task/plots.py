@@ -14,9 +14,9 @@ import numpy as np
 from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
-    from lynxplan.task.run import TaskResult
     from lynxplan.scenarios.expect import ParsedExpectation
     from lynxplan.scenarios.task import Scenario
+    from lynxplan.task.run import TaskResult
 
 MOTION_COLOURS = {"line": "tab:red", "free": "tab:blue"}
 OBSTACLE_COLOUR = "tab:orange"

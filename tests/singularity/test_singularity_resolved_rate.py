@@ -15,6 +15,7 @@ from lynxplan.exceptions import (
     TaskError,
 )
 from lynxplan.scenarios import load_scenario
+from lynxplan.scenarios.singularity import build_problem
 from lynxplan.singularity.measures import manipulability, task_jacobian
 from lynxplan.singularity.resolved_rate import (
     PathReference,
@@ -29,7 +30,6 @@ from lynxplan.singularity.resolved_rate import (
     run_reference,
     run_resolved_rate,
 )
-from lynxplan.scenarios.singularity import build_problem
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "singularity_line.yaml"
 #: numba kernel (closed form) vs Python reference (Pinocchio): same arithmetic up to rounding,

@@ -8,8 +8,7 @@ from pathlib import Path
 import pytest
 
 from lynxplan.exceptions import ScenarioError
-from lynxplan.scenarios import run_scenario
-from lynxplan.scenarios import load_scenario
+from lynxplan.scenarios import load_scenario, run_scenario
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "singularity_line.yaml"
 

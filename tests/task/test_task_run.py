@@ -12,8 +12,7 @@ from task_fixtures import scenario_dict, write_scenario
 from lynxplan.cli import main
 from lynxplan.collision import clearance_profile
 from lynxplan.exceptions import ScenarioError
-from lynxplan.scenarios import run_scenario
-from lynxplan.scenarios import load_scenario
+from lynxplan.scenarios import load_scenario, run_scenario
 from lynxplan.task.run import execute
 from lynxplan.task.setup import resolve
 from lynxplan.units import INCH
@@ -148,7 +147,11 @@ def test_failed_run_leaves_earlier_outputs_intact(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="disk full"):
         run_scenario(changed, out, quick=False)
     assert (out / "report.json").read_text() == before
-    assert sorted(p.name for p in out.iterdir()) == [".lynxplan-output", "report.json", "trajectory.csv"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".lynxplan-output",
+        "report.json",
+        "trajectory.csv",
+    ]
     assert not [p for p in tmp_path.iterdir() if "staging" in p.name]
 
 

@@ -29,7 +29,9 @@ def test_shipped_scenarios_run_and_hold_their_expectations(name: str, tmp_path: 
 
 def test_free_motion_report_matches_the_lspb_formulas(tmp_path: Path) -> None:
     run_scenario(SCENARIOS / "free_motion.yaml", tmp_path, quick=True)
-    stats = json.loads((tmp_path / "report.json").read_text())["details"]["segments"][0]["comparison"]
+    stats = json.loads((tmp_path / "report.json").read_text())["details"]["segments"][0][
+        "comparison"
+    ]
     # dA / T with T = tt - ta = 2 s and dA / (T ta) for the report's example.
     delta = [1.2, 0.9, 0.68, 1.0, 0.0]
     assert stats["lspb"]["peak_velocity_rad_s"] == pytest.approx([d / 2 for d in delta], abs=1e-9)
