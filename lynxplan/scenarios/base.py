@@ -45,7 +45,7 @@ def located_error(loc: tuple[int | str, ...], message: str, value: Any = None) -
     from pydantic import ValidationError
     from pydantic_core import InitErrorDetails, PydanticCustomError
 
-    error = PydanticCustomError("scenario", message.replace("{", "{{").replace("}", "}}"))  # type: ignore[misc]
+    error = PydanticCustomError("scenario", message.replace("{", "{{").replace("}", "}}"))
     return ValidationError.from_exception_data(
         "scenario", [InitErrorDetails(type=error, loc=loc, input=value)]
     )

@@ -130,7 +130,9 @@ def _resolve(key: str, metrics: Mapping[str, Quantity]) -> tuple[str, str | None
     raise ValueError(f"unknown expectation {key!r}; valid: {shown}")
 
 
-def parse_comparison(text: Any, quantity: str, units: Units, default_op: str | None) -> tuple:
+def parse_comparison(
+    text: Any, quantity: str, units: Units, default_op: str | None
+) -> tuple[str, float, float | None]:
     """``"<op> <number> [unit] [+- tol [unit]]"`` -> (op, value in SI, tolerance in SI or None).
 
     Raises:
@@ -217,7 +219,7 @@ def parse_expectations(
         try:
             parsed.append(parse_expectation(str(key), text, metrics, units))
         except ValueError as exc:
-            error = PydanticCustomError("expectation", str(exc))  # type: ignore[misc]
+            error = PydanticCustomError("expectation", str(exc))
             raise ValidationError.from_exception_data(
                 "expect", [InitErrorDetails(type=error, loc=("expect", str(key)), input=text)]
             ) from None
@@ -284,10 +286,10 @@ def _evaluate_equals(
         message = f"{key}: every value within {_display(tolerance, parsed.quantity, units)}"
     else:
         row = int(np.unravel_index(int(np.argmax(error)), error.shape)[0]) if error.ndim else 0
-        pick = (lambda a: a[row]) if error.ndim else (lambda a: a)
+        measured, expected = (values[row], wanted[row]) if error.ndim else (values, wanted)
         message = (
-            f"{key}[{row}]: measured {_display(pick(values), parsed.quantity, units)}, expected "
-            f"{_display(pick(wanted), parsed.quantity, units)} within "
+            f"{key}[{row}]: measured {_display(measured, parsed.quantity, units)}, expected "
+            f"{_display(expected, parsed.quantity, units)} within "
             f"{_display(tolerance, parsed.quantity, units)}"
         )
     return ExpectationResult(key, text, got, passed, message)

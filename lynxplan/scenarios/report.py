@@ -82,7 +82,7 @@ class ReportModel(BaseModel):
     model_config = ConfigDict(extra="forbid", title="lynxplan report")
 
     kind: str = Field(description="Scenario kind.")
-    schema_version: int = Field(SCHEMA_VERSION, ge=1, description="Version of this layout.")
+    schema_version: int = Field(ge=1, le=SCHEMA_VERSION, description="Version of this layout.")
     name: str = Field(description="Scenario name.")
     inputs: dict[str, Any] = Field(description="The scenario echoed, normalised to SI units.")
     metrics: dict[str, Any] = Field(

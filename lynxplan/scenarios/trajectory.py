@@ -174,7 +174,7 @@ class Input(ScenarioModel):
                     f"q{j + 1} = {values[j]:g} {self.units.angle} is outside its joint limits "
                     f"[{low:g}, {high:g}] {self.units.angle}"
                 )
-                error = PydanticCustomError("joint_limit", message)  # type: ignore[misc]
+                error = PydanticCustomError("joint_limit", message)
                 raise ValidationError.from_exception_data(
                     type(self).__name__,
                     [InitErrorDetails(type=error, loc=(*loc, int(j)), input=values[j])],
