@@ -118,6 +118,27 @@ class ScenarioModel(StrictModel):
         return self.model_dump(mode="json", by_alias=True, exclude={"expect"})
 
 
+def scaled(value: Any, factor: float) -> Any:
+    """``value`` (a number or nested lists of numbers; None passes) times ``factor``."""
+    if value is None or isinstance(value, bool):
+        return value
+    if isinstance(value, (list, tuple)):
+        return [scaled(v, factor) for v in value]
+    if isinstance(value, (int, float)):
+        return value * factor
+    return value
+
+
+def scale_translation(pose: Any, factor: float) -> Any:
+    """Rows of a 3x4 / 4x4 pose with the translation column times ``factor``."""
+    if pose is None:
+        return None
+    return [[*row[:3], row[3] * factor] if i < 3 else list(row) for i, row in enumerate(pose)]
+
+
+SI_UNITS = {"length": "m", "angle": "rad"}
+
+
 @dataclass(frozen=True)
 class KindOutput:
     """What a kind's ``run`` computed.

@@ -16,7 +16,15 @@ import numpy as np
 from pydantic import Field, model_validator
 
 from lynxplan.arm import Arm, load_arm
-from lynxplan.scenarios.base import KindOutput, Quantity, ScenarioModel, StrictModel, Units
+from lynxplan.scenarios.base import (
+    SI_UNITS,
+    KindOutput,
+    Quantity,
+    ScenarioModel,
+    StrictModel,
+    Units,
+    scaled,
+)
 from lynxplan.singularity.measures import (
     make_task,
     max_manipulability,
@@ -112,6 +120,19 @@ class Input(ScenarioModel):
     control: Control = Control()
     tr: TrSettings
     dls: DlsSettings = DlsSettings()
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs in [m] and [rad]."""
+        length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
+        data = super().si_inputs()
+        data["units"] = dict(SI_UNITS)
+        data["line"].update(
+            start=scaled(self.line.start, length),
+            end=scaled(self.line.end, length),
+            pitch=scaled(self.line.pitch, angle),
+        )
+        data["q_reference"] = scaled(self.q_reference, angle)
+        return data
 
 
 Scenario = Input

@@ -52,6 +52,7 @@ from pydantic import Discriminator, Field, Tag, model_validator
 from typing_extensions import Self
 
 from lynxplan.scenarios.base import (
+    SI_UNITS,
     KindOutput,
     Quantity,
     RobotRef,
@@ -59,8 +60,11 @@ from lynxplan.scenarios.base import (
     StrictModel,
     Units,
     located_error,
+    scale_translation,
+    scaled,
 )
 from lynxplan.trajectory.lspb import LspbTiming
+from lynxplan.units import angle_factor, length_factor
 
 NAME = "task"
 
@@ -264,6 +268,31 @@ class Input(ScenarioModel):
     self_collision: bool = Field(False, description="Also check non-adjacent link pairs.")
     compare: bool = Field(True, description="Run the ruckig and toppra comparisons.")
     outputs: OutputsEntry = Field(default_factory=OutputsEntry)
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs in [m] and [rad] (limits in rad/s^n)."""
+        length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
+        data = super().si_inputs()
+        data["units"] = dict(SI_UNITS)
+        for entry in data["obstacles"]:
+            for key in ("min_corner", "centre", "size", "radius", "length"):
+                entry[key] = scaled(entry.get(key), length)
+            entry["rpy"] = scaled(entry.get("rpy"), angle)
+        for entry in data["waypoints"].values():
+            entry["q"] = scaled(entry["q"], angle)
+            entry["q_reference"] = scaled(entry["q_reference"], angle)
+            entry["position"] = scaled(entry["position"], length)
+            entry["pose"] = scale_translation(entry["pose"], length)
+        for key in ("velocity", "acceleration", "jerk"):
+            data["limits"][key] = scaled(data["limits"][key], angle)
+        if data["writing_plane"] is not None:
+            plane = data["writing_plane"]
+            plane.update(
+                point=scaled(plane["point"], length),
+                size=scaled(plane["size"], length),
+                tilt=scaled(plane["tilt"], angle),
+            )
+        return data
 
     @model_validator(mode="after")
     def _route_names_exist(self) -> Self:

@@ -34,7 +34,16 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 from lynxplan.arm.geometry import JointLimits
 from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
-from lynxplan.scenarios.base import KindOutput, Quantity, ScenarioModel, StrictModel, Units
+from lynxplan.scenarios.base import (
+    SI_UNITS,
+    KindOutput,
+    Quantity,
+    ScenarioModel,
+    StrictModel,
+    Units,
+    scale_translation,
+    scaled,
+)
 from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import (
@@ -138,6 +147,19 @@ class Input(ScenarioModel):
     sample_rate: float = Field(default=DEFAULT_SAMPLE_RATE, gt=0, le=1e5, allow_inf_nan=False)
     compare: bool = Field(default=True, description="Run the ruckig and toppra comparisons.")
     plot: PlotEntry = Field(default_factory=PlotEntry)
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs in [m] and [rad] (limits in rad/s^2, rad/s^3)."""
+        length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
+        data = super().si_inputs()
+        data["units"] = dict(SI_UNITS)
+        data["start"] = scaled(self.start, angle)
+        for entry, seg in zip(data["segments"], self.segments, strict=True):
+            entry["to_q"] = scaled(seg.to_q, angle)
+            entry["to_pose"] = scale_translation(seg.to_pose, length)
+        for key in ("acceleration", "jerk"):
+            data["limits"][key] = scaled(getattr(self.limits, key), angle)
+        return data
 
     @model_validator(mode="after")
     def _plot_segment_exists(self) -> Input:
