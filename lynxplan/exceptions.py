@@ -128,14 +128,35 @@ class ScenarioError(LynxplanError):
         file: Path of the scenario file.
         location: Key path inside the file, e.g. ``"segments[3].ta"``, or ``""``.
         reason: What is wrong.
+        line: 1-based line of the key in the file, when known.
     """
 
-    def __init__(self, file: str, location: str, reason: str) -> None:
+    def __init__(self, file: str, location: str, reason: str, line: int | None = None) -> None:
         self.file = file
         self.location = location
         self.reason = reason
+        self.line = line
         where = f"{file}, {location}" if location else file
-        super().__init__(f"scenario {where}: {reason}")
+        at = f" (line {line})" if line is not None else ""
+        super().__init__(f"scenario {where}: {reason}{at}")
+
+
+class ScenarioValueError(LynxplanError):
+    """A scenario value found unusable while running it (e.g. an unreachable waypoint).
+
+    The scenario runner turns it into a :class:`ScenarioError` naming the file and the line.
+
+    Attributes:
+        loc: Key path inside the scenario, e.g. ``("waypoints", "O2", "pose")``.
+        reason: What is wrong.
+        value: The offending value, or None.
+    """
+
+    def __init__(self, loc: tuple[str | int, ...], reason: str, value: object = None) -> None:
+        self.loc = loc
+        self.reason = reason
+        self.value = value
+        super().__init__(reason)
 
 
 class TimingError(InputError):
