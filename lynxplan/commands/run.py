@@ -15,11 +15,16 @@ def register(subparsers: Any) -> None:
     parser.add_argument("scenario", help="scenario YAML file")
     parser.add_argument("--out", default="out", help="output folder (default: ./out)")
     parser.add_argument("--quick", action="store_true", help="skip plots and HTML")
+    parser.add_argument("--server", help="run on a lynxplan server (URL) instead of locally")
     parser.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
     """Run the scenario; exit 0 when every expectation holds, 1 otherwise."""
+    if args.server:
+        from lynxplan.client import run_remote
+
+        return run_remote(args.server, args.scenario, args.out, quick=args.quick)
     try:
         outcome = run_scenario(args.scenario, args.out, quick=args.quick)
     except ScenarioError:

@@ -36,8 +36,10 @@ def handle(args: argparse.Namespace) -> int:
 
     token = _read_token(args.token_file)
     if token is None and not _is_loopback(args.host):
-        raise InputError(f"binding to {args.host} requires --token-file (only loopback may "
-                         "serve without a token)")
+        raise InputError(
+            f"binding to {args.host} requires --token-file (only loopback may "
+            "serve without a token)"
+        )
     if args.workers < 1 or not 0 < args.port < 65536:
         raise InputError("--workers must be >= 1 and --port within 1..65535")
     config = ServiceConfig(
@@ -46,8 +48,14 @@ def handle(args: argparse.Namespace) -> int:
         dask_scheduler=args.dask_scheduler, run_timeout=args.run_timeout,
         run_memory=int(args.run_memory * 1024**3),
     )  # fmt: skip
-    uvicorn.run(create_app(config), host=args.host, port=args.port, log_level=args.log_level,
-                access_log=False, server_header=False)
+    uvicorn.run(
+        create_app(config),
+        host=args.host,
+        port=args.port,
+        log_level=args.log_level,
+        access_log=False,
+        server_header=False,
+    )
     return 0
 
 

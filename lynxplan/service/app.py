@@ -35,8 +35,14 @@ PUBLIC_PATHS = ("/health", "/", "/favicon.ico")
 PUBLIC_PREFIXES = ("/static/",)
 #: Batches at least this large are solved off the event loop (or on Dask when configured).
 THREAD_BATCH = 2_000
-SCENARIO_MEDIA_TYPES = ("application/json", "application/yaml", "application/x-yaml",
-                        "text/yaml", "text/x-yaml", "text/plain")
+SCENARIO_MEDIA_TYPES = (
+    "application/json",
+    "application/yaml",
+    "application/x-yaml",
+    "text/yaml",
+    "text/x-yaml",
+    "text/plain",
+)
 
 
 @dataclass(frozen=True)
@@ -107,8 +113,12 @@ def create_app(config: ServiceConfig) -> FastAPI:
         yield
         state.pop("runs").close()
 
-    app = FastAPI(title="lynxplan", version=__version__, lifespan=lifespan,
-                  description="Kinematics, collision checks, trajectories and scenario runs.")
+    app = FastAPI(
+        title="lynxplan",
+        version=__version__,
+        lifespan=lifespan,
+        description="Kinematics, collision checks, trajectories and scenario runs.",
+    )
     _install_error_handlers(app)
     if config.token:
         app.add_middleware(TokenMiddleware, token=config.token)
@@ -122,7 +132,7 @@ def create_app(config: ServiceConfig) -> FastAPI:
     def batch_limit(request: Request) -> int:
         return config.max_batch if wire.is_binary(request) else config.max_json_batch
 
-    # -- meta ---------------------------------------------------------------------------------
+    # -- meta ----------------------------------------
     @app.get("/health", tags=["meta"])
     async def health() -> Response:
         return wire.json_response({"status": "ok"})
@@ -131,10 +141,15 @@ def create_app(config: ServiceConfig) -> FastAPI:
     async def version() -> Response:
         import pinocchio
 
-        return wire.json_response({"lynxplan": __version__, "api": API_VERSION,
-                                   "python": platform.python_version(),
-                                   "pinocchio": pinocchio.__version__,
-                                   "executor": "dask" if config.dask_scheduler else "local"})
+        return wire.json_response(
+            {
+                "lynxplan": __version__,
+                "api": API_VERSION,
+                "python": platform.python_version(),
+                "pinocchio": pinocchio.__version__,
+                "executor": "dask" if config.dask_scheduler else "local",
+            }
+        )
 
     @app.get("/robots", tags=["robots"])
     async def robots() -> Response:
@@ -144,13 +159,14 @@ def create_app(config: ServiceConfig) -> FastAPI:
     async def robot(name: str) -> Response:
         return wire.json_response(describe_robot(name))
 
-    # -- kinematics -----------------------------------------------------------------------------
+    # -- kinematics ----------------------------------------
     @app.post("/fk", tags=["kinematics"], openapi_extra=openapi_body("FkRequest", binary=True))
     async def fk(request: Request, robot: str = Query("al5")) -> Response:
         if wire.is_binary(request):
             body: dict[str, Any] = {"robot": robot}
-            q_value: Any = wire.decode_binary(request, await wire.read_body(request,
-                                                                            config.max_body), "q")
+            q_value: Any = wire.decode_binary(
+                request, await wire.read_body(request, config.max_body), "q"
+            )
         else:
             body = await json_body(request)
             q_value = body.get("q")
@@ -170,8 +186,9 @@ def create_app(config: ServiceConfig) -> FastAPI:
         if wire.is_binary(request):
             raw = await wire.read_body(request, config.max_body)
             body: dict[str, Any] = {"robot": robot, "approach_only": approach_only}
-            T = wire.as_array(wire.decode_binary(request, raw, "T"), "T", (4, 4),
-                              limit=config.max_batch)
+            T = wire.as_array(
+                wire.decode_binary(request, raw, "T"), "T", (4, 4), limit=config.max_batch
+            )
             batch, only_approach = T.ndim == 3, approach_only
         else:
             body = await json_body(request)
@@ -179,8 +196,9 @@ def create_app(config: ServiceConfig) -> FastAPI:
         arm = get_robot(inputs.robot_name(body))
         if not batch:
             select = inputs.choice(body, "select", ("nearest", "report"))
-            result, residual = compute.ik_single(arm, T, inputs.reference(body, None), select,
-                                                 only_approach)
+            result, residual = compute.ik_single(
+                arm, T, inputs.reference(body, None), select, only_approach
+            )
             return wire.json_response(_ik_single_json(result, residual))
         reference = inputs.reference(body, len(T))
         arrays = await _ik_batch(runs(), config, T, reference, only_approach)
@@ -188,7 +206,7 @@ def create_app(config: ServiceConfig) -> FastAPI:
             return wire.npz_response(arrays, {"count": len(T)})
         return wire.json_response({"count": len(T), **arrays})
 
-    # -- collision and trajectories -------------------------------------------------------------
+    # -- collision and trajectories ----------------------------------------
     @app.post("/check", tags=["collision"], openapi_extra=openapi_body("CheckRequest"))
     async def check(request: Request) -> Response:
         body = await json_body(request)
@@ -203,8 +221,7 @@ def create_app(config: ServiceConfig) -> FastAPI:
         except (KeyError, TypeError) as exc:
             raise Problem(422, f"obstacle: {str(exc).strip(chr(39))}", "obstacles") from None
         self_collision = inputs.flag(body, "self_collision")
-        result = await asyncio.to_thread(compute.check_arrays, arm, q, t, obstacles,
-                                         self_collision)
+        result = await asyncio.to_thread(compute.check_arrays, arm, q, t, obstacles, self_collision)
         return wire.json_response(result)
 
     @app.post("/trajectory", tags=["trajectory"], openapi_extra=openapi_body("TrajectoryRequest"))
@@ -213,21 +230,25 @@ def create_app(config: ServiceConfig) -> FastAPI:
         arm = get_robot(inputs.robot_name(body))
         waypoints = wire.as_array(body.get("waypoints"), "waypoints", (5,), limit=1000)
         if waypoints.ndim != 2 or len(waypoints) < 2:
-            raise Problem(422, "waypoints must hold at least two configurations (M, 5)",
-                          "waypoints")
+            raise Problem(
+                422, "waypoints must hold at least two configurations (M, 5)", "waypoints"
+            )
         method = inputs.choice(body, "method", ("lspb", "ruckig", "toppra"))
         rate = inputs.number(body, "rate", 100.0, 1.0, 10_000.0)
         timing = _timing(body) if method == "lspb" else None
         limits = inputs.motion_limits(body, arm)
-        profiles = await asyncio.to_thread(compute.trajectory_profiles, arm, waypoints, method,
-                                           rate, limits, timing)
-        return wire.json_response({
-            "method": method,
-            "duration": float(sum(p.t[-1] for p in profiles)),
-            "segments": [p._asdict() for p in profiles],
-        })
+        profiles = await asyncio.to_thread(
+            compute.trajectory_profiles, arm, waypoints, method, rate, limits, timing
+        )
+        return wire.json_response(
+            {
+                "method": method,
+                "duration": float(sum(p.t[-1] for p in profiles)),
+                "segments": [p._asdict() for p in profiles],
+            }
+        )
 
-    # -- runs -----------------------------------------------------------------------------------
+    # -- runs ----------------------------------------
     @app.post("/runs", status_code=202, tags=["runs"], openapi_extra=openapi_body("Scenario"))
     async def submit_run(request: Request, quick: bool = Query(False)) -> Response:
         kind = wire.media_type(request)
@@ -250,12 +271,14 @@ def create_app(config: ServiceConfig) -> FastAPI:
         return wire.json_response(record.as_json(), status=202)
 
     @app.get("/runs", tags=["runs"])
-    async def list_runs(offset: int = Query(0, ge=0), limit: int = Query(50, ge=1, le=500)
-                        ) -> Response:
+    async def list_runs(
+        offset: int = Query(0, ge=0), limit: int = Query(50, ge=1, le=500)
+    ) -> Response:
         records, total = runs().store.page(offset, limit)
         items = [{k: v for k, v in r.as_json().items() if k != "report"} for r in records]
-        return wire.json_response({"items": items, "total": total, "offset": offset,
-                                   "limit": limit})
+        return wire.json_response(
+            {"items": items, "total": total, "offset": offset, "limit": limit}
+        )
 
     @app.get("/runs/{run_id}", tags=["runs"])
     async def get_run(run_id: str) -> Response:
@@ -279,7 +302,7 @@ def create_app(config: ServiceConfig) -> FastAPI:
         media = mimetypes.guess_type(path.name)[0] or "application/octet-stream"
         return FileResponse(path, media_type=media)
 
-    # -- web page -------------------------------------------------------------------------------
+    # -- web page ----------------------------------------
     @app.get("/", include_in_schema=False)
     async def page() -> Response:
         return HTMLResponse(_static("index.html").decode())
@@ -314,8 +337,9 @@ async def _ik_batch(
     from lynxplan.service.jobs import DaskPool
 
     if isinstance(manager.pool, DaskPool) and len(T) >= config.dask_batch:
-        future = manager.pool.client.submit(compute.ik_batch_arrays, T, reference, approach,
-                                            pure=False)
+        future = manager.pool.client.submit(
+            compute.ik_batch_arrays, T, reference, approach, pure=False
+        )
         result: dict[str, np.ndarray] = await asyncio.to_thread(future.result)
         return result
     return await _maybe_threaded(len(T), compute.ik_batch_arrays, T, reference, approach)  # type: ignore[no-any-return]
@@ -339,8 +363,10 @@ def _timing(body: dict[str, Any]) -> tuple[float, float] | None:
         return None
     if not isinstance(timing, dict) or set(timing) != {"tt", "ta"}:
         raise Problem(422, "timing must be an object {tt, ta} in s", "timing")
-    return (inputs.number(timing, "tt", 0.0, 1e-6, 3600.0),
-            inputs.number(timing, "ta", 0.0, 1e-9, 1800.0))
+    return (
+        inputs.number(timing, "tt", 0.0, 1e-6, 3600.0),
+        inputs.number(timing, "ta", 0.0, 1e-9, 1800.0),
+    )
 
 
 def _record(manager: RunManager, run_id: str) -> Any:
@@ -366,16 +392,19 @@ def _install_error_handlers(app: FastAPI) -> None:
     async def on_validation(request: Request, exc: RequestValidationError) -> Response:
         first = exc.errors()[0] if exc.errors() else {"loc": (), "msg": "invalid request"}
         loc = [str(part) for part in first.get("loc", ())][1:]
-        return problem_response(422, str(first.get("msg", "invalid")),
-                                ".".join(loc) or None, request.url.path)
+        return problem_response(
+            422, str(first.get("msg", "invalid")), ".".join(loc) or None, request.url.path
+        )
 
     @app.exception_handler(LynxplanError)
     async def on_domain(request: Request, exc: LynxplanError) -> Response:
         field = getattr(exc, "name", None)
-        return problem_response(422, str(exc), field if isinstance(field, str) else None,
-                                request.url.path)
+        return problem_response(
+            422, str(exc), field if isinstance(field, str) else None, request.url.path
+        )
 
     @app.exception_handler(Exception)
     async def on_crash(request: Request, exc: Exception) -> Response:
-        return problem_response(500, f"internal error ({type(exc).__name__})", None,
-                                request.url.path)
+        return problem_response(
+            500, f"internal error ({type(exc).__name__})", None, request.url.path
+        )

@@ -26,8 +26,9 @@ def fk_arrays(arm: Any, q: np.ndarray) -> dict[str, Any]:
     T = arm.fk(q)
     configs = q.reshape(-1, 5)
     poses = T.reshape(-1, 4, 4)
-    picks = np.unique(np.linspace(0, len(configs) - 1, min(len(configs), FK_VERIFICATION_SAMPLES))
-                      .astype(np.intp))
+    picks = np.unique(
+        np.linspace(0, len(configs) - 1, min(len(configs), FK_VERIFICATION_SAMPLES)).astype(np.intp)
+    )
     residual = max(
         float(np.abs(arm.frame_placement(configs[i]) - poses[i]).max()) for i in picks.tolist()
     )
@@ -118,18 +119,24 @@ def check_arrays(
     world = CollisionWorld(arm, obstacles, self_collision=self_collision)
     out: dict[str, Any] = {"within_limits": within, "all_within_limits": bool(within.all())}
     if t is None:
-        clearance = clearance_profile(world, configs) if obstacles else np.full((len(configs), 0),
-                                                                                 np.inf)
+        clearance = (
+            clearance_profile(world, configs) if obstacles else np.full((len(configs), 0), np.inf)
+        )
         per_config = clearance.min(axis=1) if clearance.shape[1] else np.full(len(configs), np.inf)
-        out.update(clearance=clearance, min_clearance=per_config,
-                   collision_free=bool((per_config > 0).all()),
-                   obstacles=[o.name for o in obstacles])
+        out.update(
+            clearance=clearance,
+            min_clearance=per_config,
+            collision_free=bool((per_config > 0).all()),
+            obstacles=[o.name for o in obstacles],
+        )
         return out
     report = check_trajectory(world, configs, t)
     out.update(
         collision_free=report.collision_free,
         certified=report.certified,
         min_clearance=report.min_clearance._asdict(),
+        segments=[record._asdict() for record in report.segments],
+        segment_ids=list(report.segment_ids),
         contacts=[c._asdict() for c in report.contacts],
         refined_intervals=report.refined_intervals,
         exact_queries=report.exact_queries,

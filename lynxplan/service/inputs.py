@@ -34,8 +34,9 @@ def choice(body: dict[str, Any], name: str, options: tuple[str, ...]) -> str:
     """A string field among ``options`` (default: the first)."""
     value = body.get(name, options[0])
     if value not in options:
-        raise Problem(422, f"{name} must be one of {', '.join(options)}. Got: {value!r}"[:160],
-                      name)
+        raise Problem(
+            422, f"{name} must be one of {', '.join(options)}. Got: {value!r}"[:160], name
+        )
     return str(value)
 
 
@@ -55,8 +56,11 @@ def reference(body: dict[str, Any], count: int | None) -> np.ndarray | None:
         return None
     array = as_array(body["q_reference"], "q_reference", (5,), batch=count is not None)
     if array.ndim == 2 and array.shape[0] != count:
-        raise Problem(422, f"q_reference must have shape (5,) or ({count}, 5). Got: {array.shape}",
-                      "q_reference")
+        raise Problem(
+            422,
+            f"q_reference must have shape (5,) or ({count}, 5). Got: {array.shape}",
+            "q_reference",
+        )
     return array
 
 
@@ -86,8 +90,11 @@ def ik_target(body: dict[str, Any], limit: int) -> tuple[np.ndarray, bool, bool]
         position = as_array(body["position"], "position", (3,), limit=limit)
         approach = as_array(body["approach"], "approach", (3,), limit=limit)
         if position.shape != approach.shape:
-            raise Problem(422, f"approach must have the shape of position {position.shape}. "
-                               f"Got: {approach.shape}", "approach")
+            raise Problem(
+                422,
+                f"approach must have the shape of position {position.shape}. Got: {approach.shape}",
+                "approach",
+            )
         poses = pose_from_position_approach(position.reshape(-1, 3), approach.reshape(-1, 3))
         return (poses, True, True) if position.ndim == 2 else (poses[0], False, True)
     raise Problem(422, "give the target as T (4x4 pose) or as position and approach", "T")
@@ -111,16 +118,26 @@ def motion_limits(body: dict[str, Any], arm: Any) -> Any:
         raise Problem(422, "limits must be an object", "limits")
     unknown = set(given) - {"velocity", "acceleration", "jerk"}
     if unknown:
-        raise Problem(422, f"unknown limit {sorted(unknown)[0]!r}; limits: velocity, "
-                           "acceleration, jerk", f"limits.{sorted(unknown)[0]}")
+        raise Problem(
+            422,
+            f"unknown limit {sorted(unknown)[0]!r}; limits: velocity, acceleration, jerk",
+            f"limits.{sorted(unknown)[0]}",
+        )
     values: dict[str, Any] = {}
     for name, value in given.items():
-        array = as_array(value, f"limits.{name}", (5,)) if isinstance(value, list) else \
-            as_array(value, f"limits.{name}", ())
+        array = (
+            as_array(value, f"limits.{name}", (5,))
+            if isinstance(value, list)
+            else as_array(value, f"limits.{name}", ())
+        )
         if (array <= 0).any():
             raise Problem(422, f"limits.{name} must be positive", f"limits.{name}")
         values[name] = array
     base = MotionLimits.from_joint_limits(arm.limits)
     velocity = values.get("velocity", base.velocity)
-    return MotionLimits(base.position, velocity, values.get("acceleration", base.acceleration),
-                        values.get("jerk", base.jerk))
+    return MotionLimits(
+        base.position,
+        velocity,
+        values.get("acceleration", base.acceleration),
+        values.get("jerk", base.jerk),
+    )

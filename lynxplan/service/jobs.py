@@ -15,6 +15,7 @@ server process are marked ``interrupted``; finished runs keep their report and a
 
 from __future__ import annotations
 
+import contextlib
 import json
 import multiprocessing
 import queue
@@ -128,8 +129,14 @@ class JobStore:
         with self._lock:
             self._db.execute(
                 "INSERT INTO runs (id, state, kind, name, quick, created) VALUES (?,?,?,?,?,?)",
-                (record.id, record.state, record.kind, record.name, int(record.quick),
-                 record.created),
+                (
+                    record.id,
+                    record.state,
+                    record.kind,
+                    record.name,
+                    int(record.quick),
+                    record.created,
+                ),
             )
 
     def update(self, run_id: str, **values: Any) -> None:
@@ -195,7 +202,7 @@ def _record(row: tuple[Any, ...]) -> RunRecord:
     )  # fmt: skip
 
 
-# -- executing one run (in a worker process or on a Dask worker) ------------------------------------
+# -- executing one run (in a worker process or on a Dask worker) --------------------
 def execute_run(scenario_path: str, out_dir: str, quick: bool) -> dict[str, Any]:
     """Run a scenario file into ``out_dir``; never raises.
 
@@ -236,12 +243,23 @@ def _expectation_ok(expectation: Any) -> bool:
     return bool(True if ok is None else ok)
 
 
-def _run_scenario(scenario_path: str, out_dir: str, quick: bool) -> Any:
+def _scenarios_api() -> Any:
+    """The scenarios contract package if present, else the older runner (same call shape)."""
+    import importlib
+
     try:
-        from lynxplan.scenarios import run_scenario
+        return importlib.import_module("lynxplan.scenarios")
     except ImportError:
-        from lynxplan.runner import run_scenario
-    return run_scenario(scenario_path, out_dir, quick=quick)
+        return None
+
+
+def _run_scenario(scenario_path: str, out_dir: str, quick: bool) -> Any:
+    api = _scenarios_api()
+    if api is None:
+        from lynxplan.runner import run_scenario as run_old
+
+        return run_old(scenario_path, out_dir, quick=quick)
+    return api.run_scenario(scenario_path, out_dir, quick=quick)
 
 
 def execute_run_packed(source: str, quick: bool) -> dict[str, Any]:
@@ -266,19 +284,19 @@ def validate_scenario(source: str) -> tuple[str, str]:
     with tempfile.TemporaryDirectory(prefix="lynxplan-check-") as folder:
         path = Path(folder) / "scenario.yaml"
         path.write_text(source, encoding="utf-8")
-        try:
-            from lynxplan.scenarios import load_scenario as load_new
-        except ImportError:
+        api = _scenarios_api()
+        scenario: Any
+        if api is None:
             from lynxplan.scenario import load_scenario
 
             _, scenario = load_scenario(path)
         else:
-            loaded = load_new(path)
+            loaded = api.load_scenario(path)
             scenario = getattr(loaded, "model", loaded[1] if isinstance(loaded, tuple) else loaded)
     return str(getattr(scenario, "kind", "")), str(getattr(scenario, "name", "") or "")
 
 
-# -- local worker processes -----------------------------------------------------------------------
+# -- local worker processes ----------------------------------------
 def _worker_main(connection: Any, memory_limit: int) -> None:
     """A worker process: run scenarios received on ``connection`` until it closes."""
     _die_with_parent()
@@ -336,8 +354,12 @@ class _WorkerSlot:
             return
         context = multiprocessing.get_context("spawn")
         parent, child = context.Pipe()
-        process = context.Process(target=_worker_main, args=(child, self._memory_limit),
-                                  daemon=True, name="lynxplan-run-worker")
+        process = context.Process(
+            target=_worker_main,
+            args=(child, self._memory_limit),
+            daemon=True,
+            name="lynxplan-run-worker",
+        )
         process.start()
         child.close()
         self._process, self._connection = process, parent
@@ -391,10 +413,8 @@ class LocalPool:
             thread.start()
 
     def _serve(self, slot: _WorkerSlot) -> None:
-        try:
+        with contextlib.suppress(RuntimeError):
             slot.ensure()  # start (and warm) the worker before the first run arrives
-        except RuntimeError:
-            pass
         while (job := self._queue.get()) is not None:
             if job.cancelled.is_set():
                 continue
@@ -417,9 +437,10 @@ class DaskPool:
     """Runs (and large IK batches) submitted to a Dask ``distributed`` scheduler."""
 
     def __init__(self, address: str, timeout: float, finish: Finish) -> None:
-        from distributed import Client
+        import distributed
 
-        self.client = Client(address, timeout=30, set_as_default=False)
+        connect: Any = distributed.Client
+        self.client: Any = connect(address, timeout=30, set_as_default=False)
         self._timeout, self._finish = timeout, finish
 
     def submit(self, job: _Job) -> None:
@@ -428,7 +449,7 @@ class DaskPool:
 
     def _wait(self, job: _Job) -> None:
         self._finish(job, {"started": time.time()})
-        future = self.client.submit(execute_run_packed, job.source, job.quick, pure=False)
+        future: Any = self.client.submit(execute_run_packed, job.source, job.quick, pure=False)
         deadline = time.monotonic() + self._timeout
         while not future.done():
             if job.cancelled.is_set():
@@ -437,8 +458,9 @@ class DaskPool:
                 return
             if time.monotonic() > deadline:
                 future.cancel()
-                self._finish(job, {"error": f"the run exceeded its time limit of "
-                                            f"{self._timeout:g} s"})
+                self._finish(
+                    job, {"error": f"the run exceeded its time limit of {self._timeout:g} s"}
+                )
                 return
             time.sleep(0.05)
         try:
@@ -504,14 +526,20 @@ class RunManager:
             job = self._jobs.get(run_id)
         if job is not None:
             job.cancelled.set()
-        self.store.transition(run_id, ("queued", "running"), state="cancelled",
-                              finished=time.time(), error="cancelled by the client")
+        self.store.transition(
+            run_id,
+            ("queued", "running"),
+            state="cancelled",
+            finished=time.time(),
+            error="cancelled by the client",
+        )
         return self.store.get(run_id)
 
     def _finish(self, job: _Job, answer: dict[str, Any]) -> None:
         if "started" in answer:
-            self.store.transition(job.run_id, ("queued",), state="running",
-                                  started=answer["started"])
+            self.store.transition(
+                job.run_id, ("queued",), state="running", started=answer["started"]
+            )
             return
         with self._lock:
             self._jobs.pop(job.run_id, None)
@@ -525,8 +553,14 @@ class RunManager:
             return
         if "error" in answer:
             shutil.rmtree(job.out_dir, ignore_errors=True)
-            self.store.transition(job.run_id, ("queued", "running"), state="failed",
-                                  finished=now, error=answer["error"], timings=timings)
+            self.store.transition(
+                job.run_id,
+                ("queued", "running"),
+                state="failed",
+                finished=now,
+                error=answer["error"],
+                timings=timings,
+            )
             return
         timings["run"] = answer["seconds"]
         self.store.transition(

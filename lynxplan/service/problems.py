@@ -23,7 +23,7 @@ _TITLES = {
 }
 
 
-class Problem(Exception):
+class Problem(Exception):  # noqa: N818 (named after RFC 9457)
     """An error answered as ``application/problem+json``.
 
     Attributes:
@@ -59,7 +59,9 @@ def problem_response(
     """A problem+json response (no traceback, one-line detail)."""
     headers = {"WWW-Authenticate": "Bearer"} if status == 401 else None
     return Response(
-        orjson.dumps(problem_body(status, detail.splitlines()[0] if detail else "", field, instance)),
+        orjson.dumps(
+            problem_body(status, detail.splitlines()[0] if detail else "", field, instance)
+        ),
         status_code=status,
         media_type=PROBLEM_MEDIA_TYPE,
         headers=headers,

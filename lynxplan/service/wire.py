@@ -87,8 +87,9 @@ def decode_binary(request: Request, body: bytes, field: str) -> np.ndarray:
     try:
         shape = tuple(int(part) for part in shape_header.split(","))
     except ValueError:
-        raise Problem(422, f"X-Shape must be integers separated by commas. Got: {shape_header!r}",
-                      "X-Shape") from None
+        raise Problem(
+            422, f"X-Shape must be integers separated by commas. Got: {shape_header!r}", "X-Shape"
+        ) from None
     if any(n < 0 for n in shape) or len(body) != 8 * int(np.prod(shape, dtype=np.int64)):
         raise Problem(
             422, f"body of {len(body)} bytes does not hold float64 of shape {shape}", "X-Shape"
@@ -115,17 +116,21 @@ def as_array(
         raise Problem(422, f"{field} must contain numbers only. Got: {_describe(value)}", field)
     expected = str(trailing) if not batch else f"{trailing} or (N, {', '.join(map(str, trailing))})"
     single = array.shape == trailing
-    if not single and not (batch and array.ndim == len(trailing) + 1
-                           and array.shape[1:] == trailing):
+    if not single and not (
+        batch and array.ndim == len(trailing) + 1 and array.shape[1:] == trailing
+    ):
         raise Problem(422, f"{field} must have shape {expected}. Got: {array.shape}", field)
     if limit and not single and array.shape[0] > limit:
-        raise Problem(413, f"{field}: batch of {array.shape[0]} exceeds the limit of {limit}", field)
+        raise Problem(
+            413, f"{field}: batch of {array.shape[0]} exceeds the limit of {limit}", field
+        )
     array = np.ascontiguousarray(array, dtype=np.float64)
     finite = np.isfinite(array)
     if not finite.all():
         where = np.argwhere(~finite)[0].tolist()
-        raise Problem(422, f"{field} contains NaN or infinite values (first at {where})",
-                      f"{field}{where}")
+        raise Problem(
+            422, f"{field} contains NaN or infinite values (first at {where})", f"{field}{where}"
+        )
     return array
 
 
@@ -149,8 +154,7 @@ def dumps(content: Any) -> bytes:
 
 def json_response(content: Any, status: int = 200) -> Response:
     """A JSON response serialised by orjson (numpy arrays natively, NaN as null)."""
-    return Response(dumps(content), status_code=status,
-                    media_type="application/json")
+    return Response(dumps(content), status_code=status, media_type="application/json")
 
 
 def npz_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
@@ -159,15 +163,17 @@ def npz_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
     with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_STORED) as archive:
         for name, array in arrays.items():
             with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
-                np.lib.format.write_array(member, np.ascontiguousarray(array),
-                                          allow_pickle=False)
+                np.lib.format.write_array(member, np.ascontiguousarray(array), allow_pickle=False)
     return buffer.getvalue()
 
 
 def npz_response(arrays: Mapping[str, np.ndarray], scalars: Mapping[str, Any]) -> Response:
     """An npz answer; ``scalars`` travel as JSON in the ``X-Result`` header."""
-    return Response(npz_bytes(arrays), media_type=NPZ_MEDIA_TYPE,
-                    headers={"X-Result": orjson.dumps(scalars).decode()})
+    return Response(
+        npz_bytes(arrays),
+        media_type=NPZ_MEDIA_TYPE,
+        headers={"X-Result": orjson.dumps(scalars).decode()},
+    )
 
 
 def read_npz(data: bytes) -> dict[str, np.ndarray]:
