@@ -183,9 +183,9 @@ def toppra_profile(
         RetimingError: toppra found no parameterisation, or the samples still exceed the limits
             after :data:`TOPPRA_RESCALE_ROUNDS` slow-downs.
     """
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint
+    from lynxplan._toppra import import_toppra
+
+    toppra = import_toppra()
 
     if isinstance(segment, LineSegment):
         s, waypoints = segment.grid.s, segment.grid.q
