@@ -33,9 +33,9 @@ _HOMES = {
 }
 
 __all__ = [
+    "BRANCH_NAMES",
     "Arm",
     "ArmGeometry",
-    "BRANCH_NAMES",
     "IkBatch",
     "IkResult",
     "IkSolution",

@@ -25,7 +25,7 @@ _FAST = {"contract", "arcp"}
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _dot3(u: np.ndarray, v: np.ndarray) -> float:
     """Dot product of two 3-vectors (numba's ``@`` calls BLAS: slow for 3 elements)."""
-    return u[0] * v[0] + u[1] * v[1] + u[2] * v[2]
+    return float(u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
 
 
 class IkStatus(IntEnum):
@@ -174,12 +174,12 @@ def _rigidity_deviation(T: np.ndarray, k: int, approach_only: bool) -> float:
     dev = max(abs(T[k, 3, 0]), abs(T[k, 3, 1]), abs(T[k, 3, 2]), abs(T[k, 3, 3] - 1.0))
     if approach_only:
         norm2 = T[k, 0, 2] * T[k, 0, 2] + T[k, 1, 2] * T[k, 1, 2] + T[k, 2, 2] * T[k, 2, 2]
-        return max(dev, abs(math.sqrt(norm2) - 1.0))
+        return float(max(dev, abs(math.sqrt(norm2) - 1.0)))
     for i in range(3):
         for j in range(i, 3):  # R^T R is symmetric
             dot = T[k, 0, i] * T[k, 0, j] + T[k, 1, i] * T[k, 1, j] + T[k, 2, i] * T[k, 2, j]
             dev = max(dev, abs(dot - (1.0 if i == j else 0.0)))
-    return dev
+    return float(dev)
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)

@@ -134,7 +134,7 @@ def signed_distance(obstacle: Obstacle, points: np.ndarray) -> np.ndarray:
     """Exact signed distance of points (..., 3) to an obstacle, in [m] (negative inside)."""
     local = (points - obstacle.centre) @ np.asarray(obstacle.rotation)
     if isinstance(obstacle, SphereObstacle):
-        return np.linalg.norm(local, axis=-1) - obstacle.radius
+        return np.asarray(np.linalg.norm(local, axis=-1) - obstacle.radius)
     if isinstance(obstacle, BoxObstacle):
         excess = np.abs(local) - obstacle.size / 2.0
     elif isinstance(obstacle, CylinderObstacle):
@@ -146,4 +146,4 @@ def signed_distance(obstacle: Obstacle, points: np.ndarray) -> np.ndarray:
             axis=-1,
         )
     outside = np.linalg.norm(np.maximum(excess, 0.0), axis=-1)
-    return outside + np.minimum(excess.max(axis=-1), 0.0)
+    return np.asarray(outside + np.minimum(excess.max(axis=-1), 0.0))

@@ -205,7 +205,7 @@ class CollisionWorld:
             )
             gaps = np.linalg.norm(centres[:, sa, None, :] - centres[:, None, sb, :], axis=-1)
             bounds[:, p] = gaps.min(axis=(1, 2)) - self._sphere_radius[a] - self._sphere_radius[b]
-        return bounds
+        return np.asarray(bounds)
 
     def distance(self, poses: np.ndarray, pair: int) -> float:
         """Signed distance of one pair, in [m]; negative: minus the penetration depth.
@@ -289,7 +289,7 @@ class CollisionWorld:
         bounds = per_link[:, self.pair_link]
         if self.pair_is_self.any():
             bounds[:, self.pair_is_self] += per_link[:, self.pair_other[self.pair_is_self]]
-        return bounds
+        return np.asarray(bounds)
 
 
 def _configurations(q: Any, nq: int) -> np.ndarray:

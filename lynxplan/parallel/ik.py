@@ -165,7 +165,7 @@ def solve_ik(pose: np.ndarray, geometry: ParallelGeometry = _DEFAULT_GEOMETRY) -
     for i in range(3):
         if not result.reachable[0, i]:
             raise LegUnreachableError(LEG_NAMES[i], float(result.leg_distance[0, i]), *result.reach)
-    return result.angles[0]
+    return np.asarray(result.angles[0])
 
 
 def platform_joints(

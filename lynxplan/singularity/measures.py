@@ -30,6 +30,7 @@ from the base axis, ``r_w`` that of the wrist centre):
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -150,6 +151,17 @@ def condition_number(
     return float(ratio) if np.ndim(q) == 1 else ratio
 
 
+if TYPE_CHECKING:  # the names below, for type checkers (explicit re-exports)
+    from lynxplan.singularity.classify import (
+        Singularity,
+        SingularityDistance,
+        max_manipulability,
+        near_singularities,
+        nearest_singularity,
+        singular_conditions,
+        singularity_distances,
+    )
+
 #: Names re-exported from :mod:`lynxplan.singularity.classify` (loaded on first use: it builds
 #: on this module).
 _CLASSIFY_NAMES = (
@@ -174,6 +186,8 @@ def __getattr__(name: str) -> object:
 __all__ = [
     "NAMED_TASKS",
     "ROW_NAMES",
+    "Singularity",
+    "SingularityDistance",
     "Task",
     "condition_number",
     "extended_jacobian",
@@ -185,8 +199,13 @@ __all__ = [
     "manipulability_and_gradient",
     "manipulability_gradient",
     "manipulability_kernel",
+    "max_manipulability",
     "measures_kernel",
+    "near_singularities",
+    "nearest_singularity",
+    "singular_conditions",
     "singular_values",
+    "singularity_distances",
     "task_jacobian",
     "task_jacobian_derivative",
 ]

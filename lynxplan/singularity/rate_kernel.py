@@ -332,4 +332,4 @@ def resolved_rate_kernel(
         q += qd * settings.dt
         t += settings.dt
         tau = min(tau + rate * settings.dt, end)
-    return steps
+    return int(steps)

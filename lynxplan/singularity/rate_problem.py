@@ -191,7 +191,7 @@ class ResolvedRateRun(NamedTuple):
     @property
     def position_error(self) -> np.ndarray:
         """Distance of the tool point from the reference point, shape (N,), in [m]."""
-        return np.linalg.norm(self.x[:, :3] - self.x_ref[:, :3], axis=1)
+        return np.asarray(np.linalg.norm(self.x[:, :3] - self.x_ref[:, :3], axis=1))
 
 
 @dataclass(frozen=True)
@@ -244,7 +244,7 @@ class ResolvedRateProblem:
     def max_steps(self) -> int:
         """Step budget: the path time times the max time factor, plus the hold."""
         total = self.path.duration * RESOLVED_RATE_MAX_TIME_FACTOR + self.path.hold
-        return int(math.ceil(total / self.dt)) + 2
+        return math.ceil(total / self.dt) + 2
 
     @property
     def columns(self) -> np.ndarray:

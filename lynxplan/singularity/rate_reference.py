@@ -17,7 +17,7 @@ from lynxplan.singularity.rate_problem import (
 )
 
 
-def run_reference(
+def run_reference(  # noqa: PLR0915 (mirrors the kernel's steps in one readable loop)
     problem: ResolvedRateProblem, strategy: str | Strategy, arm: Any, *, max_steps: int
 ) -> ResolvedRateRun:
     """The same algorithm as :func:`run_resolved_rate`, step by step in Python with numpy and

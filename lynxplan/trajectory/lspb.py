@@ -164,7 +164,7 @@ def lspb_scalar(t: float, tt: float, ta: float) -> tuple[float, float, float]:
 
 def unit_lspb_scalar(t: float, timing: LspbTiming) -> tuple[float, float, float]:
     """:func:`unit_lspb` at one time since the start ``t`` in [s], in plain floats."""
-    return lspb_scalar(t, timing.tt, timing.ta)  # type: ignore[no-any-return]
+    return lspb_scalar(t, timing.tt, timing.ta)
 
 
 def lspb_since_start(

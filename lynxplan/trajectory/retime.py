@@ -102,7 +102,7 @@ class ProfileStats(NamedTuple):
 
 def sample_times(duration: float, rate: float) -> np.ndarray:
     """Times 0, 1/rate, ... and the duration itself, shape (N,), in [s]."""
-    count = int(math.floor(duration * rate + 1e-9)) + 1
+    count = math.floor(duration * rate + 1e-9) + 1
     t = np.arange(count) / rate
     return t if t[-1] >= duration - 1e-12 else np.append(t, duration)
 

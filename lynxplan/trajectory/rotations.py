@@ -34,7 +34,7 @@ def quaternion_to_matrix(quaternion: np.ndarray) -> np.ndarray:
 
     qn = np.asarray(quaternion, dtype=float)
     matrices = Rotation.from_quat(_xyzw(qn.reshape(-1, 4))).as_matrix()
-    return matrices.reshape(*qn.shape[:-1], 3, 3)
+    return np.asarray(matrices.reshape(*qn.shape[:-1], 3, 3))
 
 
 def axis_angle_matrix(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
@@ -44,7 +44,8 @@ def axis_angle_matrix(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
 
     k = np.asarray(axis, dtype=float)
     angle = np.asarray(angle, dtype=float)
-    return Rotation.from_rotvec(np.multiply.outer(angle, k)).as_matrix().reshape(-1, 3, 3)
+    matrices = Rotation.from_rotvec(np.multiply.outer(angle, k)).as_matrix()
+    return np.asarray(matrices.reshape(-1, 3, 3))
 
 
 def slerp(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -67,7 +68,7 @@ def component_blend(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     if q0 @ q1 < 0:
         q1 = -q1
-    return q0 + np.asarray(s, dtype=float)[:, None] * (q1 - q0)
+    return np.asarray(q0 + np.asarray(s, dtype=float)[:, None] * (q1 - q0))
 
 
 def drive_parameters(T_a: np.ndarray, T_b: np.ndarray) -> tuple[np.ndarray, float, float, float]:
