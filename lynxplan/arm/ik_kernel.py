@@ -222,8 +222,12 @@ def _reach_miss(r_w: float, z_w: float, a2: float, a3: float) -> float:
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _write_branches(
-    k: int, front: tuple[float, float, float, float, float], elbow_angles: tuple[float, float],
-    params: IkParams, q_out: np.ndarray, within_out: np.ndarray,
+    k: int,
+    front: tuple[float, float, float, float, float],
+    elbow_angles: tuple[float, float],
+    params: IkParams,
+    q_out: np.ndarray,
+    within_out: np.ndarray,
 ) -> None:
     """Step 4: the four branches of pose k from the front branch's ``(q1, q234, phi, q5, r_w)``
     and the elbow's ``(|q3|, beta)``, wrapped into the limits with their within-limit flags."""

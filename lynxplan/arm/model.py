@@ -50,6 +50,7 @@ def _ik() -> ModuleType:
         _IK_MODULE = ik
     return _IK_MODULE
 
+
 DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
 #: Tolerance on the URDF's DH structure (rotations, zero offsets), unitless / [m].
 _STRUCTURE_TOLERANCE = 1e-9

@@ -35,6 +35,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._arrays import as_rows
 from lynxplan.constants import (
     PARALLEL_FK_DUPLICATE_TOLERANCE,
     PARALLEL_FK_UNIT_CIRCLE_TOLERANCE,
@@ -82,12 +83,7 @@ class ParallelFKResult(NamedTuple):
 
 
 def _as_thetas(theta: np.ndarray) -> np.ndarray:
-    array = np.asarray(theta, dtype=float)
-    if array.ndim not in (1, 2) or array.shape[-1] != 3:
-        raise ShapeError("theta", "(3,) or (N, 3)", array.shape)
-    if not np.all(np.isfinite(array)):
-        raise NonFiniteInputError("theta")
-    return array.reshape(-1, 3)
+    return as_rows(theta, 3, "theta")
 
 
 @numba.njit(cache=True, nogil=True)

@@ -162,21 +162,11 @@ if TYPE_CHECKING:  # the names below, for type checkers (explicit re-exports)
         singularity_distances,
     )
 
-#: Names re-exported from :mod:`lynxplan.singularity.classify` (loaded on first use: it builds
-#: on this module).
-_CLASSIFY_NAMES = (
-    "Singularity",
-    "SingularityDistance",
-    "max_manipulability",
-    "near_singularities",
-    "nearest_singularity",
-    "singular_conditions",
-    "singularity_distances",
-)
-
 
 def __getattr__(name: str) -> object:
-    if name in _CLASSIFY_NAMES:
+    """The names of :mod:`lynxplan.singularity.classify` listed in ``__all__``, loaded on first
+    use (classify builds on this module)."""
+    if name in __all__:
         from lynxplan.singularity import classify
 
         return getattr(classify, name)
