@@ -184,26 +184,29 @@ def _rigidity_deviation(T: np.ndarray, k: int, approach_only: bool) -> float:
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _arm_plane(
-    px: float, py: float, a_t: np.ndarray, q_ref: np.ndarray, r_k: int
+    px: float, py: float, approach: tuple[float, float, float], q1_ref: float, pitch_ref: float
 ) -> tuple[float, float, float, float]:
     """Step 2: the arm plane's radial unit vector ``(c1, s1)`` towards the tool point (front
-    branch) and the approach projected into it, ``(s234, c234)``."""
+    branch) and the ``approach`` axis projected into it, ``(s234, c234)``; ``q1_ref`` and
+    ``pitch_ref`` (q2 + q3 + q4) in [rad] decide where the pose leaves them free. Scalars only:
+    array arguments would cost reference counting in the per-pose loop."""
+    ax, ay, az = approach
     rho = math.sqrt(px * px + py * py)
     if rho > BASE_AXIS_TOLERANCE_K:
         c1, s1 = px / rho, py / rho
     else:
         # On the base axis q1 is free: face the approach if it leans, else keep the reference.
-        horizontal = math.hypot(a_t[0], a_t[1])
+        horizontal = math.hypot(ax, ay)
         if horizontal > 1e-9:
-            c1, s1 = a_t[0] / horizontal, a_t[1] / horizontal
+            c1, s1 = ax / horizontal, ay / horizontal
         else:
-            c1, s1 = math.cos(q_ref[r_k, 0]), math.sin(q_ref[r_k, 0])
+            c1, s1 = math.cos(q1_ref), math.sin(q1_ref)
     # Approach projected into the plane: a_s = (c1 s234, s1 s234, -c234).
-    s234 = c1 * a_t[0] + s1 * a_t[1]
-    c234 = -a_t[2]
+    s234 = c1 * ax + s1 * ay
+    c234 = -az
     norm = math.sqrt(s234 * s234 + c234 * c234)
     if norm < 1e-12:  # approach normal to the arm plane: any pitch is as good
-        s234, c234 = sincos(q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3])
+        s234, c234 = sincos(pitch_ref)
     else:
         s234, c234 = s234 / norm, c234 / norm
     return c1, s1, s234, c234
@@ -331,7 +334,9 @@ def ik_kernel(T: np.ndarray, q_ref: np.ndarray, params: IkParams, out: IkOutputs
             a_t[i] = T[k, i, 2]
             n_t[i] = T[k, i, 0]
         _orthonormalise(a_t, n_t, o_t, params.approach_only)
-        c1, s1, s234, c234 = _arm_plane(px, py, a_t, q_ref, r_k)
+        pitch_ref = q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3]
+        approach = (a_t[0], a_t[1], a_t[2])
+        c1, s1, s234, c234 = _arm_plane(px, py, approach, q_ref[r_k, 0], pitch_ref)
         # Wrist centre in plane coordinates (radial r, height z).
         r_w = c1 * px + s1 * py - d5 * s234
         z_w = pz + d5 * c234
