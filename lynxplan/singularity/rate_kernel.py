@@ -193,34 +193,6 @@ def _task_coordinates(q: np.ndarray, a2: float, a3: float, d5: float, x: np.ndar
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _task_state(
-    q: np.ndarray,
-    arm: tuple[float, float, float],
-    task: RateTask,
-    path: RatePath,
-    tau: float,
-    scratch: RateScratch,
-    J: np.ndarray,
-    e: np.ndarray,
-    ff: np.ndarray,
-) -> float:
-    """Step 1: task Jacobian ``J`` (k, 5), reached ``x`` and reference ``xr`` (4,) (in
-    ``scratch``), error ``e`` and feed-forward ``ff`` (k,) at path time ``tau``; returns the
-    manipulability."""
-    E, x, xr, xrd = scratch.E, scratch.x, scratch.xr, scratch.xrd
-    a2, a3, d5 = arm
-    extended_jacobian_kernel(q, a2, a3, d5, E)
-    for i in range(task.rows.shape[0]):
-        J[i] = E[task.rows[i]]
-    _task_coordinates(q, a2, a3, d5, x)
-    path_sample_kernel(path.points, path.duration, path.blend, tau, xr, xrd)
-    for i in range(task.rows.shape[0]):
-        e[i] = xr[task.columns[i]] - x[task.columns[i]]
-        ff[i] = xrd[task.columns[i]]
-    return manipulability_kernel(J)
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
 def _dls_rate(J: np.ndarray, xc: np.ndarray, m: float, settings: RateSettings) -> np.ndarray:
     """Damped least squares, damping rising below ``m_dls``: (J^T J + lambda^2 I) qd = J^T xc."""
     lam2 = settings.lambda_min * settings.lambda_min
@@ -241,11 +213,12 @@ def _tr_command(
     m: float,
     xc: np.ndarray,
     settings: RateSettings,
-    scratch: RateScratch,
+    dE: np.ndarray,
+    grad: np.ndarray,
 ) -> tuple[np.ndarray, float]:
-    """Task reconstruction: the reconstructed command ``xdot_p`` and ``k1(m)``."""
+    """Task reconstruction: the reconstructed command ``xdot_p`` and ``k1(m)``; ``dE`` (8, 5, 5)
+    and ``grad`` (5,) are work arrays."""
     k = rows.shape[0]
-    dE, grad = scratch.dE, scratch.grad
     extended_jacobian_derivative_kernel(q, arm[0], arm[1], arm[2], dE)
     # gradient of m: m tr(J^+ dJ_j)
     for j in range(5):
@@ -275,7 +248,8 @@ def _joint_rate(
     e: np.ndarray,
     ff: np.ndarray,
     settings: RateSettings,
-    scratch: RateScratch,
+    dE: np.ndarray,
+    grad: np.ndarray,
 ) -> tuple[np.ndarray, float, float]:
     """Step 2: the strategy's joint rate ``qd`` (5,), ``k1`` and the path-clock rate."""
     gain = settings.gain
@@ -288,7 +262,7 @@ def _joint_rate(
         rate = _speed_scale(qa, qb, settings.vmax)
         return rate * qa + qb, 0.0, rate
     if settings.strategy == _TR:
-        xc, k1 = _tr_command(q, arm, rows, Jp, m, ff + gain * e, settings, scratch)
+        xc, k1 = _tr_command(q, arm, rows, Jp, m, ff + gain * e, settings, dE, grad)
         return Jp @ xc, k1, 1.0
     return Jp @ (ff + gain * e), 0.0, 1.0
 
@@ -312,19 +286,32 @@ def resolved_rate_kernel(
     e = np.empty(k)
     ff = np.empty(k)
     q = q0.copy()
+    a2, a3, d5 = arm
+    rows, columns, points = task.rows, task.columns, path.points
+    E, x, xr, xrd, dE, grad = scratch
     t = 0.0
     tau = 0.0
     end = path.duration + path.hold
     steps = out.t.shape[0]
     for n in range(steps):
-        m = _task_state(q, arm, task, path, tau, scratch, J, e, ff)
-        qd, k1, rate = _joint_rate(q, arm, task.rows, J, m, e, ff, settings, scratch)
+        # Step 1, the task state: J, x, the reference, e, ff and m (written out here: array
+        # arguments of a helper cost reference counting at every step).
+        extended_jacobian_kernel(q, a2, a3, d5, E)
+        for i in range(k):
+            J[i] = E[rows[i]]
+        _task_coordinates(q, a2, a3, d5, x)
+        path_sample_kernel(points, path.duration, path.blend, tau, xr, xrd)
+        for i in range(k):
+            e[i] = xr[columns[i]] - x[columns[i]]
+            ff[i] = xrd[columns[i]]
+        m = manipulability_kernel(J)
+        qd, k1, rate = _joint_rate(q, arm, rows, J, m, e, ff, settings, dE, grad)
         out.t[n] = t
         out.path_time[n] = tau
         out.q[n] = q
         out.qd[n] = qd
-        out.x[n] = scratch.x
-        out.x_ref[n] = scratch.xr
+        out.x[n] = x
+        out.x_ref[n] = xr
         out.m[n] = m
         out.k1[n] = k1
         if tau >= end - 1e-12:
