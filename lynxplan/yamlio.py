@@ -66,7 +66,7 @@ def _line(node: yaml.Node | yaml.Event) -> int | None:
 
 
 def _error(path: Path, reason: str, line: int | None = None) -> ScenarioError:
-    return ScenarioError(str(path), "" if line is None else f"line {line}", reason)
+    return ScenarioError(str(path), "", reason, line)
 
 
 def _read_text(path: Path, max_bytes: int) -> str:
@@ -192,6 +192,20 @@ def read_yaml_mapping(
     Raises:
         ScenarioError: naming the file (and the line where known) and what is wrong.
     """
+    data, _ = read_yaml_document(
+        path, max_bytes=max_bytes, max_depth=max_depth, max_nodes=max_nodes
+    )
+    return data
+
+
+def read_yaml_document(
+    path: str | Path,
+    *,
+    max_bytes: int = MAX_FILE_BYTES,
+    max_depth: int = MAX_DEPTH,
+    max_nodes: int = MAX_NODES,
+) -> tuple[dict[str, Any], yaml.MappingNode]:
+    """As :func:`read_yaml_mapping`, and the composed node tree (for key-path line numbers)."""
     path = Path(path)
     text = _read_text(path, max_bytes)
     try:
@@ -222,4 +236,4 @@ def read_yaml_mapping(
     for key in data:
         if not isinstance(key, str):
             raise _error(path, f"top-level key {key!r} is not a string")
-    return data  # type: ignore[no-any-return]
+    return data, node
