@@ -16,6 +16,7 @@ from typing import Any, Literal, NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.arm import ik as _ik
 from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
 from lynxplan.arm.kinematics import as_configurations, forward_kinematics, tool_jacobian
@@ -25,6 +26,7 @@ from lynxplan.constants import (
     STRICT_ORIENTATION_TOLERANCE,
 )
 from lynxplan.exceptions import (
+    InputError,
     ModelError,
     NonFiniteInputError,
     NoSolutionWithinLimitsError,
@@ -151,12 +153,21 @@ class Arm:
 
     # -- kinematics -------------------------------------------------------------------------------
     def fk(self, q: np.ndarray) -> np.ndarray:
-        """Tool pose (closed form). q: shape (5,) or (N, 5) in [rad] -> (4, 4) or (N, 4, 4), [m]."""
-        return forward_kinematics(q, self.geometry)
+        """Tool pose (closed form). q: shape (5,) or (N, 5) in [rad] -> (4, 4) or (N, 4, 4), [m].
+
+        Raises:
+            LynxplanInputError: q of another shape or dtype, NaN/Inf, |q| > 100 rad, a batch
+                beyond the resource limit (see :mod:`lynxplan.guards`).
+        """
+        return forward_kinematics(guards.configurations("q", q), self.geometry)
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5)."""
-        return tool_jacobian(q, self.geometry)
+        """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5).
+
+        Raises:
+            LynxplanInputError: as :meth:`fk`.
+        """
+        return tool_jacobian(guards.configurations("q", q), self.geometry)
 
     def frame_placement(self, q: np.ndarray, frame: str = TOOL_FRAME) -> np.ndarray:
         """Pose of a URDF frame from Pinocchio. q: shape (5,) in [rad] -> (4, 4) in [m].
@@ -165,7 +176,7 @@ class Arm:
         """
         import pinocchio as pin
 
-        config = as_configurations(q)[0]
+        config = as_configurations(guards.configurations("q", q))[0]
         frame_id = self._frame_id(frame)
         pin.forwardKinematics(self.model, self.data, config)
         return np.array(pin.updateFramePlacement(self.model, self.data, frame_id).homogeneous)
@@ -174,7 +185,7 @@ class Arm:
         """Pinocchio frame Jacobian, LOCAL_WORLD_ALIGNED. q: (5,) in [rad] -> (6, 5)."""
         import pinocchio as pin
 
-        config = as_configurations(q)[0]
+        config = as_configurations(guards.configurations("q", q))[0]
         return np.array(
             pin.computeFrameJacobian(
                 self.model,
@@ -200,14 +211,24 @@ class Arm:
         approach_only: bool = False,
         limit_tolerance: float = LIMIT_SNAP_TOLERANCE,
     ) -> _ik.IkBatch:
-        """All-branch IK of many poses; see :func:`lynxplan.arm.ik.solve_ik_batch`."""
+        """All-branch IK of many poses; see :func:`lynxplan.arm.ik.solve_ik_batch`.
+
+        Raises:
+            LynxplanInputError: T not of shape (4, 4) or (N, 4, 4) real numbers, NaN/Inf,
+                translations beyond 1 km, a bottom row other than 0 0 0 1, rotation blocks that
+                are reflections or not orthonormal (within 1e-3), q_reference out of range,
+                a batch beyond the resource limit (see :mod:`lynxplan.guards`).
+        """
+        poses = guards.poses("T", T, approach_only=approach_only)
+        if q_reference is not None:
+            q_reference = guards.angles("q_reference", q_reference)
         return _ik.solve_ik_batch(
-            T,
+            poses,
             geometry=self.geometry,
             limits=self.limits,
             q_reference=q_reference,
             approach_only=approach_only,
-            limit_tolerance=limit_tolerance,
+            limit_tolerance=guards.tolerance("limit_tolerance", limit_tolerance, "rad"),
         )
 
     def ik(
@@ -235,23 +256,25 @@ class Arm:
             limit_tolerance: Angles this far outside a limit, in [rad], are snapped onto it.
 
         Raises:
-            ShapeError, NonFiniteInputError, NotRigidTransformError: bad input.
+            LynxplanInputError (ShapeError, NonFiniteInputError, NotRigidTransformError,
+                OutOfRangeError): bad input, see :mod:`lynxplan.guards`.
             UnreachablePoseError: the wrist centre is out of reach (carries the distance).
             OrientationNotReachableError: strict mode and a residual above the tolerance.
         """
-        pose = np.asarray(T, dtype=float)
-        if pose.shape != (4, 4):
-            raise ShapeError("T", "(4, 4)", pose.shape)
+        pose = guards.poses("T", T, batch=False, approach_only=approach_only)
         if select not in ("nearest", "report"):
-            raise ValueError(f"select must be 'nearest' or 'report'. Got: {select!r}")
+            raise InputError(f"select must be 'nearest' or 'report'. Got: {select!r:.60}")
+        orientation_tolerance = guards.tolerance(
+            "orientation_tolerance", orientation_tolerance, "rad"
+        )
+        limit_tolerance = guards.tolerance("limit_tolerance", limit_tolerance, "rad")
         if q_reference is None:
             reference = _ZEROS
         else:
-            reference = np.asarray(q_reference, dtype=float)
+            reference = guards.float_array("q_reference", q_reference)
             if reference.shape != (5,):
                 raise ShapeError("q_reference", "(5,)", reference.shape)
-            if not np.isfinite(reference).all():
-                raise NonFiniteInputError("q_reference")
+            reference = guards.angles("q_reference", reference)
         rows, scalars = np.empty((4, 8)), np.empty(5)
         flags = (1 if approach_only else 0) | (2 if select == "report" else 0)
         params = self._ik_params
