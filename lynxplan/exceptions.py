@@ -91,9 +91,10 @@ class NonFiniteInputError(InputError):
         name: Name of the argument.
     """
 
-    def __init__(self, name: str) -> None:
+    def __init__(self, name: str, detail: str = "") -> None:
         self.name = name
-        super().__init__(f"{name} contains NaN or infinite values")
+        extra = f" ({detail})" if detail else ""
+        super().__init__(f"{name} contains NaN or infinite values{extra}")
 
 
 class UnknownUnitError(InputError):

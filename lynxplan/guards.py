@@ -39,7 +39,6 @@ from contextvars import ContextVar
 from dataclasses import dataclass, replace
 from typing import Any
 
-import numba
 import numpy as np
 
 from lynxplan.constants import RIGIDITY_REPAIR_TOLERANCE
@@ -126,7 +125,7 @@ def real(name: str, value: Any) -> float:
     except (OverflowError, ValueError):  # e.g. an int beyond the float range
         raise OutOfRangeError(name, value, "a finite number") from None
     if not math.isfinite(result):
-        raise OutOfRangeError(name, result, "a finite number")
+        raise NonFiniteInputError(name, f"{name} = {result}")
     return result
 
 
@@ -272,7 +271,10 @@ def float_array(name: str, value: Any) -> np.ndarray:
     try:
         array = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError, OverflowError) as exc:
-        reason = " ".join(str(exc).split())[:80]
+        reason = " ".join(str(exc).split())
+        if "inhomogeneous" in reason or "sequence" in reason:
+            reason = "a ragged nested list: rows of different lengths"
+        reason = reason[:80]
         raise InputError(f"{name} must be an array of real numbers ({reason})") from None
     return array
 
@@ -280,7 +282,7 @@ def float_array(name: str, value: Any) -> np.ndarray:
 def _first_bad(array: np.ndarray, bad: np.ndarray) -> str:
     index = tuple(int(i) for i in np.argwhere(bad)[0])
     where = "" if array.ndim == 0 else str(list(index))
-    return f"{where} = {array[index]!r}"
+    return f"{where} = {float(array[index])}"
 
 
 def finite_array(name: str, value: Any) -> np.ndarray:
@@ -288,7 +290,7 @@ def finite_array(name: str, value: Any) -> np.ndarray:
     array = float_array(name, value)
     bad = ~np.isfinite(array)
     if bad.any():
-        raise NonFiniteInputError(f"{name}{_first_bad(array, bad).split(' =')[0]}")
+        raise NonFiniteInputError(name, f"{name}{_first_bad(array, bad)}")
     return array
 
 
@@ -312,6 +314,25 @@ def configurations(name: str, value: Any, dof: int = 5) -> np.ndarray:
         raise ShapeError(name, f"({dof},) or (N, {dof})", array.shape)
     check_size(f"{name}: configurations in one batch", array.shape[0] if array.ndim == 2 else 1)
     return np.ascontiguousarray(angles(name, array))
+
+
+def planar_poses(name: str, value: Any) -> np.ndarray:
+    """Planar poses ``(x, y, alpha)``, shape (3,) or (N, 3), in [m, m, rad]: positions within
+    :data:`MAX_ABS_LENGTH`, angles within :data:`MAX_ABS_ANGLE`; a C-contiguous float64 array."""
+    array = float_array(name, value)
+    if array.ndim not in (1, 2) or array.shape[-1] != 3:
+        raise ShapeError(name, "(3,) or (N, 3)", array.shape)
+    check_size(f"{name}: poses in one batch", array.shape[0] if array.ndim == 2 else 1)
+    stack = finite_array(name, array).reshape(-1, 3)
+    far = np.abs(stack[:, :2]) > MAX_ABS_LENGTH
+    if far.any():
+        k, i = (int(v) for v in np.argwhere(far)[0])
+        where = f"[{k}]" if array.ndim == 2 else ""
+        raise OutOfRangeError(
+            f"{name}{where} {'xy'[i]}", float(stack[k, i]), f"|{'xy'[i]}| <= {MAX_ABS_LENGTH:g} m"
+        )
+    angles(f"{name} alpha", stack[:, 2] if array.ndim == 2 else stack[0, 2])
+    return np.ascontiguousarray(array)
 
 
 def rotation(name: str, value: Any) -> np.ndarray:
@@ -361,7 +382,7 @@ def poses(name: str, value: Any, *, batch: bool = True, approach_only: bool = Fa
         return stack if array.ndim == 3 else stack[0]
     at = f"{name}[{int(k)}]" if array.ndim == 3 else name
     if code == _POSE_NON_FINITE:
-        raise NonFiniteInputError(at)
+        raise NonFiniteInputError(name, f"in {at}")
     if code == _POSE_FAR:
         raise OutOfRangeError(f"{at} translation", detail, f"|x| <= {MAX_ABS_LENGTH:g} m")
     if code == _POSE_BOTTOM_ROW:
@@ -377,8 +398,22 @@ _POSE_OK, _POSE_NON_FINITE, _POSE_FAR, _POSE_BOTTOM_ROW = 0, 1, 2, 3
 _POSE_NOT_ORTHONORMAL, _POSE_REFLECTION = 4, 5
 
 
-@numba.njit(cache=True, nogil=True)
+_COMPILED: dict[str, Any] = {}
+
+
 def _pose_check_kernel(T: np.ndarray, max_length: float, approach_only: bool) -> np.ndarray:
+    """:func:`_pose_check`, compiled by numba on first use (``import lynxplan.guards`` stays
+    cheap for the CLI)."""
+    kernel = _COMPILED.get("pose_check")
+    if kernel is None:
+        import numba
+
+        kernel = _COMPILED["pose_check"] = numba.njit(cache=True, nogil=True)(_pose_check)
+    result: np.ndarray = kernel(T, max_length, approach_only)
+    return result
+
+
+def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.ndarray:
     """First bad pose of ``T`` (N, 4, 4): ``[index, code, detail]`` (code 0: all good)."""
     out = np.zeros(3)
     for k in range(T.shape[0]):
