@@ -22,7 +22,11 @@ from typing import Any
 from lynxplan import __version__, guards
 from lynxplan.exceptions import LynxplanError, LynxplanInputError
 
-_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+#: Negative numbers, including ``-inf`` and ``-nan`` (which the value checks then reject with a
+#: message naming the option, instead of argparse taking them for unknown options).
+_NEGATIVE_NUMBER = re.compile(
+    r"^-((\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE
+)
 
 #: Success.
 EXIT_OK = 0

@@ -64,7 +64,7 @@ class ResourceLimitError(InputError):
 
 def _short(value: object, width: int = 60) -> str:
     """``repr`` of a value cut to ``width`` characters, for one-line messages."""
-    text = repr(value)
+    text = f"{value:.6g}" if isinstance(value, float) else repr(value)
     return text if len(text) <= width else text[: width - 3] + "..."
 
 

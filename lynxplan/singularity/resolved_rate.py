@@ -160,6 +160,10 @@ class PathReference:
             raise ShapeError("points", "(M, 4) with M >= 2", points.shape)
         if not np.isfinite(points).all():
             raise InputError("path points contain NaN or infinite values")
+        from lynxplan import guards
+
+        guards.angles("path pitch", points[:, 3])
+        guards.length("path point coordinate", float(np.abs(points[:, :3]).max()))
         points.setflags(write=False)
         object.__setattr__(self, "points", points)
         _require_positive("duration", self.duration)
@@ -517,6 +521,10 @@ def run_resolved_rate(
     steps = problem.max_steps if max_steps is None else int(max_steps)
     if steps < 1:
         raise InputError(f"max_steps must be >= 1. Got: {steps}")
+    from lynxplan import guards
+
+    # Per step: t, m, q (5), qd (5), task error and reference (about 20 floats).
+    guards.check_size(f"resolved-rate steps (path time / dt = {problem.dt:.3g} s)", steps, 160.0)
     out = _allocate(steps)
     g = problem.geometry
     path = problem.path
