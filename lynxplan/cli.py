@@ -16,6 +16,7 @@ import os
 import re
 import sys
 import traceback
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
@@ -162,7 +163,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         except SystemExit as exc:  # --help, --version, usage errors (already printed)
             return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
         limit = None if max_samples is None else _max_samples(max_samples)
-        with guards.raised_limits(max_samples=limit):
+        with guards.raised_limits(max_samples=limit), warnings.catch_warnings():
+            if not debug:  # library warnings (numpy, Pinocchio) would break the one-line rule
+                warnings.simplefilter("ignore")
             code: int = args.handler(args)
         return code
     except LynxplanError as exc:
