@@ -301,6 +301,17 @@ BASES: dict[str, dict[str, Any]] = {
         "waypoints": {"A": {"q": [104, 57, -59, 40, 0]}, "B": {"q": [109, 79, -93, 25, 0]}},
         "segments": [{"from": "A", "to": "B", "motion": "free"}],
     },
+    # kind ``plan`` (issue 14): its cases run once the kind is registered
+    "plan": {
+        "kind": "plan",
+        "units": {"length": "m", "angle": "deg"},
+        "obstacles": [
+            {"name": "table", "type": "box", "centre": [0.0, 0.1, -0.105], "size": [0.9, 0.7, 0.03]}
+        ],
+        "start": [30, 60, -90, 60, 0],
+        "goal": {"q": [150, 45, -60, 90, 90]},
+        "planner": {"seed": 0, "time_limit": 5.0},
+    },
 }
 
 #: Bad values applied to every numeric key listed per kind: (value, pattern after the key path).
@@ -336,6 +347,7 @@ _NUMERIC_KEYS: dict[str, list[str]] = {
         "dls.lambda_max",
     ],
     "task": ["sample_rate", "timing.tt", "waypoints.A.q[0]", "obstacles[0].size[1]"],
+    "plan": ["start[0]", "planner.time_limit", "planner.seed"],
 }
 
 
@@ -439,6 +451,14 @@ SCENARIOS: list[S] = [
     S("task", {"obstacles[0].min_corner": [0, 0]}, r"obstacles\[0\]\.(box\.)?min_corner"),
     S("task", {"robot": {"urdf": "/nonexistent.urdf"}}, r"nonexistent\.urdf|robot"),
     S("task", {"robot": {"name": "r2d2"}}, r"robot|r2d2"),
+    S("plan", {"planner.seed": -1}, r"planner\.seed"),
+    S("plan", {"planner.seed": 2**70}, r"planner\.seed"),
+    S("plan", {"planner.time_limit": 1e9}, r"planner\.time_limit|planning time"),
+    S("plan", {"planner.time_limit": 0}, r"planner\.time_limit"),
+    S("plan", {"planner.max_nodes": 10**12}, r"planner\.max_nodes"),
+    S("plan", {"planner.sample_rate": 0}, r"planner\.sample_rate"),
+    S("plan", {"planner.goal_bias": 2}, r"planner\.goal_bias"),
+    S("plan", {"goal": {}}, r"goal"),
 ]
 
 # -- raw files ----------------------------------------------------------------------------------
