@@ -96,7 +96,8 @@ def handle_fk(args: argparse.Namespace) -> int:
 
     theta = np.radians([_angle_deg(getattr(args, n), n.upper()) for n in ("t1", "t2", "t3")])
     if args.near is not None:
-        near = _pose_mm_deg(*args.near, prefix="--near ")
+        xc, yc, alpha = args.near
+        near = _pose_mm_deg(xc, yc, alpha, prefix="--near ")
         poses = nearest_assembly_mode(theta, pose_from_mm_deg(*near))[None]
         labels = [""]
     else:

@@ -145,7 +145,7 @@ def _ik_nearest(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.n
 def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) -> Segment:
     if (spec.target_q is None) == (spec.target_pose is None):
         raise InputError(f"segment {i}: give exactly one of target_q and target_pose")
-    pose = None
+    pose = np.eye(4)  # replaced below when the target is a pose
     if spec.target_pose is not None:
         pose = guards.poses(f"segments[{i}].target_pose", spec.target_pose, batch=False)
     if spec.kind in ("free", "line"):
@@ -154,7 +154,7 @@ def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) 
         target = (
             as_configuration(spec.target_q, f"segments[{i}].target_q")
             if spec.target_q is not None
-            else _ik_nearest(pose, q, lim)  # type: ignore[arg-type]
+            else _ik_nearest(pose, q, lim)
         )
         return free_segment(q, target, spec.timing, limits=lim)
     if spec.kind == "line":
