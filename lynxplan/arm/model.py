@@ -8,6 +8,11 @@ of the same structure with other dimensions works through the same closed forms.
 from __future__ import annotations
 
 import math
+import os
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from importlib import resources
@@ -121,10 +126,13 @@ class Arm:
         self.urdf_path = Path(urdf_path) if urdf_path is not None else default_urdf_path()
         if not self.urdf_path.is_file():
             raise ModelError(f"URDF file not found: {self.urdf_path}")
-        try:
-            self.model = pin.buildModelFromUrdf(str(self.urdf_path))
-        except (RuntimeError, ValueError) as exc:
-            raise ModelError(f"cannot load URDF {self.urdf_path}: {exc}") from exc
+        with native_stderr_captured() as noise:
+            try:
+                self.model = pin.buildModelFromUrdf(str(self.urdf_path))
+            except (RuntimeError, ValueError) as exc:
+                detail = " ".join(noise().split())[:200]
+                extra = f" (parser: {detail})" if detail else ""
+                raise ModelError(f"cannot load URDF {self.urdf_path}: {exc}{extra}") from exc
         self.data = self.model.createData()
         self.geometry = _read_geometry(self.model)
         self.limits = _read_limits(self.model)
@@ -312,9 +320,45 @@ def _raise_for_status(status: int, miss: float, deviation: float) -> None:
         raise UnreachablePoseError(miss)
 
 
+@contextmanager
+def native_stderr_captured() -> Iterator[Callable[[], str]]:
+    """Capture what native code (urdfdom, Pinocchio) writes to file descriptor 2 in the block.
+
+    Yields a function returning the captured text, so that a parser's own messages become part
+    of one clear error instead of noise on the user's terminal.
+    """
+    try:
+        saved = os.dup(2)
+    except OSError:  # no usable stderr descriptor (embedded interpreter): capture nothing
+        yield lambda: ""
+        return
+    with tempfile.TemporaryFile() as sink:
+
+        def captured() -> str:
+            return os.pread(sink.fileno(), 4096, 0).decode("utf-8", "replace")
+
+        sys.stderr.flush()
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield captured
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+
 def _read_limits(model: Any) -> JointLimits:
     position = np.column_stack((model.lowerPositionLimit, model.upperPositionLimit))
     velocity = np.array(model.velocityLimit, dtype=float)
+    names = tuple(model.names)[1:]
+    for j, name in enumerate(names[: len(velocity)]):
+        lower, upper = float(position[j, 0]), float(position[j, 1])
+        if not (math.isfinite(lower) and math.isfinite(upper) and lower < upper):
+            raise ModelError(
+                f"joint {name}: position limits [{lower:g}, {upper:g}] rad must be finite with "
+                "lower < upper"
+            )
+        if not (math.isfinite(velocity[j]) and velocity[j] > 0):
+            raise ModelError(f"joint {name}: velocity limit {velocity[j]:g} rad/s must be > 0")
     position.setflags(write=False)
     velocity.setflags(write=False)
     return JointLimits(position=position, velocity=velocity)
