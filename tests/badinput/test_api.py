@@ -9,6 +9,7 @@ from __future__ import annotations
 import math
 import re
 from collections.abc import Callable
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -488,3 +489,54 @@ def test_raised_limits_allow_what_the_default_refuses() -> None:
         assert guards.count("samples", 200_000_000) == 200_000_000
     with pytest.raises(ResourceLimitError):
         guards.count("samples", 200_000_000)
+
+
+_AL5_URDF = Path(__file__).resolve().parents[2] / "urdf" / "lynxmotion_al5.urdf"
+
+#: (file content, regex of the one ModelError line)
+URDF_CASES: list[tuple[str, bytes | Callable[[str], str], str]] = [
+    ("truncated", b'<robot name="x"><link name="a"/><joint', r"cannot load URDF .*XML_ERROR"),
+    ("random bytes", bytes(range(256)) * 4, r"cannot load URDF .*\(parser: "),
+    ("empty", b"", r"cannot load URDF"),
+    ("no joints", b'<robot name="x"><link name="a"/></robot>', r"expected revolute joints"),
+    (
+        "zero limits",
+        lambda t: re.sub(r'(lower|upper)="[^"]*"', r'\1="0"', t),
+        r"joint q1: position limits \[0, 0\] rad must be finite with lower < upper",
+    ),
+    (
+        "inverted limits",
+        lambda t: re.sub(r'lower="([^"]*)" upper="([^"]*)"', r'lower="\2" upper="\1"', t),
+        r"joint q\d: position limits .* lower < upper",
+    ),
+    (
+        "zero velocity",
+        lambda t: re.sub(r'velocity="[^"]*"', 'velocity="0"', t),
+        r"joint q1: velocity limit 0 rad/s must be > 0",
+    ),
+    (
+        "renamed joint",
+        lambda t: t.replace('joint name="q3"', 'joint name="elbow"'),
+        r"expected revolute joints",
+    ),
+]
+
+
+@pytest.mark.parametrize(("name", "content", "pattern"), URDF_CASES, ids=[c[0] for c in URDF_CASES])
+def test_urdf_case(
+    tmp_path: Path, capfd: pytest.CaptureFixture[str], name: str, content: Any, pattern: str
+) -> None:
+    from lynxplan.arm.model import Arm
+    from lynxplan.exceptions import ModelError
+
+    path = tmp_path / f"{name.replace(' ', '_')}.urdf"
+    if callable(content):
+        path.write_text(content(_AL5_URDF.read_text(encoding="utf-8")), encoding="utf-8")
+    else:
+        path.write_bytes(content)
+    with pytest.raises(ModelError) as info:
+        Arm(path)
+    assert isinstance(info.value, LynxplanInputError)
+    assert "\n" not in str(info.value) and re.search(pattern, str(info.value)), str(info.value)
+    captured = capfd.readouterr()
+    assert captured.err == "", f"parser noise reached stderr: {captured.err!r}"
