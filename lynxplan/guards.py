@@ -279,6 +279,13 @@ def float_array(name: str, value: Any) -> np.ndarray:
     return array
 
 
+def _as_float64(name: str, value: Any) -> np.ndarray:
+    """:func:`float_array`, without a copy or a call when ``value`` is a float64 array already."""
+    if isinstance(value, np.ndarray) and value.dtype == np.float64:
+        return value
+    return float_array(name, value)
+
+
 def _first_bad(array: np.ndarray, bad: np.ndarray) -> str:
     index = tuple(int(i) for i in np.argwhere(bad)[0])
     where = "" if array.ndim == 0 else str(list(index))
@@ -296,7 +303,11 @@ def finite_array(name: str, value: Any) -> np.ndarray:
 
 def angles(name: str, value: Any) -> np.ndarray:
     """Joint angles of any shape: finite, ``|q| <=`` :data:`MAX_ABS_ANGLE`, in [rad]."""
-    array = finite_array(name, value)
+    array = _as_float64(name, value)
+    # Fast path, one pass: NaN makes the maximum NaN and the comparison False.
+    if array.size == 0 or np.abs(array).max() <= MAX_ABS_ANGLE:
+        return array
+    finite_array(name, array)
     bad = np.abs(array) > MAX_ABS_ANGLE
     if bad.any():
         index = tuple(int(i) for i in np.argwhere(bad)[0])
@@ -309,11 +320,13 @@ def angles(name: str, value: Any) -> np.ndarray:
 
 def configurations(name: str, value: Any, dof: int = 5) -> np.ndarray:
     """Shape ``(dof,)`` or ``(N, dof)`` joint angles in range, as a C-contiguous float64 array."""
-    array = float_array(name, value)
+    array = _as_float64(name, value)
     if array.ndim not in (1, 2) or array.shape[-1] != dof:
         raise ShapeError(name, f"({dof},) or (N, {dof})", array.shape)
-    check_size(f"{name}: configurations in one batch", array.shape[0] if array.ndim == 2 else 1)
-    return np.ascontiguousarray(angles(name, array))
+    if array.ndim == 2:
+        check_size(f"{name}: configurations in one batch", array.shape[0])
+    angles(name, array)
+    return array if array.flags.c_contiguous else np.ascontiguousarray(array)
 
 
 def planar_poses(name: str, value: Any) -> np.ndarray:
@@ -365,7 +378,7 @@ def poses(name: str, value: Any, *, batch: bool = True, approach_only: bool = Fa
     Returns:
         A C-contiguous float64 array of the input's shape.
     """
-    array = float_array(name, value)
+    array = _as_float64(name, value)
     if array.shape == (3, 3) or (batch and array.ndim == 3 and array.shape[1:] == (3, 3)):
         raise ShapeError(
             name,
@@ -375,9 +388,12 @@ def poses(name: str, value: Any, *, batch: bool = True, approach_only: bool = Fa
     ok_shape = array.shape == (4, 4) or (batch and array.ndim == 3 and array.shape[1:] == (4, 4))
     if not ok_shape:
         raise ShapeError(name, "(4, 4) or (N, 4, 4)" if batch else "(4, 4)", array.shape)
-    stack = np.ascontiguousarray(array.reshape(-1, 4, 4))
-    check_size(f"{name}: poses in one batch", stack.shape[0])
-    k, code, detail = (float(v) for v in _pose_check_kernel(stack, MAX_ABS_LENGTH, approach_only))
+    stack = array.reshape(-1, 4, 4)
+    if not stack.flags.c_contiguous:
+        stack = np.ascontiguousarray(stack)
+    if stack.shape[0] > 1:
+        check_size(f"{name}: poses in one batch", stack.shape[0])
+    k, code, detail = _pose_check_kernel(stack, MAX_ABS_LENGTH, approach_only).tolist()
     if code == _POSE_OK:
         return stack if array.ndim == 3 else stack[0]
     at = f"{name}[{int(k)}]" if array.ndim == 3 else name

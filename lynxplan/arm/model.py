@@ -24,7 +24,7 @@ import numpy as np
 from lynxplan import guards
 from lynxplan.arm import ik as _ik
 from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
-from lynxplan.arm.kinematics import as_configurations, forward_kinematics, tool_jacobian
+from lynxplan.arm.kinematics import as_configurations, fk_kernel, jacobian_kernel
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
     RIGIDITY_REPAIR_TOLERANCE,
@@ -167,7 +167,11 @@ class Arm:
             LynxplanInputError: q of another shape or dtype, NaN/Inf, |q| > 100 rad, a batch
                 beyond the resource limit (see :mod:`lynxplan.guards`).
         """
-        return forward_kinematics(guards.configurations("q", q), self.geometry)
+        batch = guards.configurations("q", q)
+        g = self.geometry
+        out = np.empty((1 if batch.ndim == 1 else batch.shape[0], 4, 4))
+        fk_kernel(batch.reshape(-1, 5), g.a2, g.a3, g.d5, out)
+        return out[0] if batch.ndim == 1 else out
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5).
@@ -175,7 +179,11 @@ class Arm:
         Raises:
             LynxplanInputError: as :meth:`fk`.
         """
-        return tool_jacobian(guards.configurations("q", q), self.geometry)
+        batch = guards.configurations("q", q)
+        g = self.geometry
+        out = np.empty((1 if batch.ndim == 1 else batch.shape[0], 6, 5))
+        jacobian_kernel(batch.reshape(-1, 5), g.a2, g.a3, g.d5, out)
+        return out[0] if batch.ndim == 1 else out
 
     def frame_placement(self, q: np.ndarray, frame: str = TOOL_FRAME) -> np.ndarray:
         """Pose of a URDF frame from Pinocchio. q: shape (5,) in [rad] -> (4, 4) in [m].
