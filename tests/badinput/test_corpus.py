@@ -78,7 +78,13 @@ def _case_id(case: C) -> str:
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-@pytest.mark.parametrize("case", CLI, ids=[_case_id(c) for c in CLI])
+_CLI_PARAMS = [
+    pytest.param(c, marks=pytest.mark.xfail(reason=f"known gap: {c.xfail}")) if c.xfail else c
+    for c in CLI
+]
+
+
+@pytest.mark.parametrize("case", _CLI_PARAMS, ids=[_case_id(c) for c in CLI])
 def test_cli_case(capsys, tmp_path: Path, out: Path, case: C) -> None:
     _check(capsys, tmp_path, out, _fill(case.argv, tmp_path, out), case.code, case.pattern)
 
