@@ -25,8 +25,9 @@ seed                        integer, ``0 <= seed < 2**63``
 Resource limits (:class:`ResourceLimits`): the number of elements (random samples, grid cells,
 poses in a batch, trajectory samples) a computation may create is at most ``max_samples``
 (default :data:`DEFAULT_MAX_SAMPLES`); a planning time limit is at most ``max_planning_time``.
-Both are raised with ``--max-samples N`` on the command line, a scenario's ``limits:`` key, or
-:func:`raised_limits` in Python.
+``max_samples`` is raised with ``--max-samples N`` on the command line (any command, ``run``
+included) and both with :func:`raised_limits` in Python (the scenario layer wraps a run in it to
+apply a file's own limits).
 """
 
 from __future__ import annotations
@@ -65,8 +66,9 @@ MAX_SEED = 2**63
 DEFAULT_MAX_SAMPLES = 100_000_000
 #: Default largest planning time limit, in [s].
 DEFAULT_MAX_PLANNING_TIME = 600.0
-#: How a user raises a resource limit (appended to every ResourceLimitError).
-HOW_TO_RAISE = "raise the limit with --max-samples N or a scenario 'limits: {max_samples: N}' key"
+#: How a user raises a resource limit (appended to every ResourceLimitError). The scenario layer
+#: applies a file's own limit with :func:`raised_limits` around the run.
+HOW_TO_RAISE = "raise the limit with --max-samples N (or raised_limits(max_samples=N) in Python)"
 
 
 @dataclass(frozen=True)
@@ -248,7 +250,7 @@ def planning_time(name: str, value: Any) -> float:
             f"{name} (planning time in s)",
             x,
             limit,
-            "raise it with a scenario 'limits: {max_planning_time: S}' key",
+            "raise it with raised_limits(max_planning_time=S) in Python",
         )
     return x
 
