@@ -228,9 +228,9 @@ def check_size(quantity: str, requested: float, bytes_per_element: float = 0.0) 
     limit = current_limits().max_samples
     if not requested <= limit:  # also catches NaN
         memory = ""
-        if bytes_per_element > 0 and math.isfinite(requested):
-            memory = f" (about {_bytes(requested * bytes_per_element)} of memory)"
-        raise ResourceLimitError(f"{quantity}{memory}", float(requested), limit, HOW_TO_RAISE)
+        if bytes_per_element > 0 and math.isfinite(_as_float(requested)):
+            memory = f" (about {_bytes(_as_float(requested) * bytes_per_element)} of memory)"
+        raise ResourceLimitError(f"{quantity}{memory}", _as_float(requested), limit, HOW_TO_RAISE)
 
 
 def grid_cells(quantity: str, extent: float, cell: float, dims: int) -> int:
@@ -253,6 +253,14 @@ def planning_time(name: str, value: Any) -> float:
             "raise it with raised_limits(max_planning_time=S) in Python",
         )
     return x
+
+
+def _as_float(n: float) -> float:
+    """``float(n)``, infinity for integers beyond the float range."""
+    try:
+        return float(n)
+    except OverflowError:
+        return math.inf
 
 
 def _bytes(n: float) -> str:

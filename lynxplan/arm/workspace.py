@@ -175,10 +175,12 @@ def estimate_workspace(
     from lynxplan import guards
 
     samples = guards.count("workspace samples", samples)
+    guards.positive_length("workspace voxel_size", voxel_size)
+    guards.positive_length("workspace cell", cell)
     rng = np.random.default_rng(guards.seed("workspace seed", seed))
     reach = geometry.max_reach
     guards.grid_cells("workspace planar grid cells", 2 * reach, cell, 2)
-    if (2 * reach / voxel_size + 2) ** 3 > 2**62:  # voxel indices must fit an int64
+    if 2 * reach / voxel_size + 2 > 2**20:  # voxel indices (per axis cubed) must fit an int64
         raise OutOfRangeError(
             "workspace voxel_size", voxel_size, f">= {2 * reach / 2**20:.3g} m for this arm"
         )

@@ -125,6 +125,11 @@ def grid_axes(
     axes = []
     for lo, hi in (x_range, y_range):
         n = int(math.floor((hi - lo) / step + 1e-9)) + 1
+        if n < 2:
+            raise InputError(
+                f"workspace grid step {step * 1e3:g} mm is larger than the region "
+                f"({(hi - lo) * 1e3:g} mm): at least 2 grid points per axis are needed"
+            )
         if n > 20_000:
             raise InputError(
                 f"workspace grid step {step * 1e3:g} mm gives {n} points per axis (at most 20000)"
