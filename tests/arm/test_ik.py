@@ -11,10 +11,10 @@ from hypothesis import strategies as st
 from lynxplan.arm import BRANCH_NAMES, IkStatus, forward_kinematics, solve_ik_batch
 from lynxplan.exceptions import (
     NonFiniteInputError,
-    OutOfRangeError,
     NoSolutionWithinLimitsError,
     NotRigidTransformError,
     OrientationNotReachableError,
+    OutOfRangeError,
     ShapeError,
     UnreachablePoseError,
 )
