@@ -51,7 +51,7 @@ CASES: list[tuple[str, bytes, str]] = [
     ("nullkey.yaml", b"kind: x\n~: 1\n", r": top-level key None is not a string"),
     ("tag.yaml", b"kind: !!python/object:os.system x\n", r": invalid YAML: could not.*\(line 1\)"),
     ("tag_apply.yaml", b"kind: !!python/object/apply:os.system [ls]\n", r"invalid YAML"),
-    ("broken.yaml", b"kind: [1, 2\n", r": invalid YAML: expected ','.*\(line 2\)"),
+    ("broken.yaml", b"kind: [1, 2\n", r": invalid YAML: .*expected ','.*\(line 2\)"),
     ("tab.yaml", b"kind: x\n\tb: 1\n", r": invalid YAML.*\(line 2\)"),
     ("colon.yaml", b"kind: x\nb: c: d\n", r": invalid YAML: mapping values.*\(line 2\)"),
     ("multi.yaml", b"a: 1\n---\nb: 2\n", r"invalid YAML: but found another document"),
@@ -84,7 +84,7 @@ CASES: list[tuple[str, bytes, str]] = [
         r": nesting deeper than 64 levels.*\(line \d+\)",
     ),
     ("bad_escape.yaml", b'kind: "\\q"\n', r": invalid YAML: found unknown escape.*\(line 1\)"),
-    ("control.yaml", b"kind: \x07\n", r"invalid YAML: .*special characters"),
+    ("control.yaml", b"kind: \x07\n", r"invalid YAML: .*(special|control) characters"),
 ]
 
 
