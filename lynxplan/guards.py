@@ -26,7 +26,7 @@ Resource limits (:class:`ResourceLimits`): the number of elements (random sample
 poses in a batch, trajectory samples) a computation may create is at most ``max_samples``
 (default :data:`DEFAULT_MAX_SAMPLES`); a planning time limit is at most ``max_planning_time``.
 ``max_samples`` is raised with ``--max-samples N`` on the command line (any command, ``run``
-included) and both with :func:`raised_limits` in Python (the scenario layer wraps a run in it to
+included) and both with :func:`raised_limits` in Python (the way for the scenario layer to
 apply a file's own limits).
 """
 
