@@ -89,7 +89,9 @@ def as_configurations(
     q: np.ndarray | list[float] | tuple[float, ...], name: str = "q"
 ) -> np.ndarray:
     """Validate joint angles: shape (5,) or (N, 5), finite. Returns a float (N, 5) array."""
-    array = np.asarray(q, dtype=float)
+    from lynxplan.guards import float_array  # strings, ragged lists: InputError, not ValueError
+
+    array = float_array(name, q)
     if array.ndim not in (1, 2) or array.shape[-1] != 5:
         raise ShapeError(name, "(5,) or (N, 5)", array.shape)
     if not np.isfinite(array).all():

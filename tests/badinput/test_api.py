@@ -559,3 +559,16 @@ def test_odd_but_valid_arrays_are_copied_not_refused() -> None:
     batch = _ARM.ik_batch(T)
     np.testing.assert_array_equal(batch.q, _ARM.ik_batch(np.ascontiguousarray(expected)).q)
     np.testing.assert_array_equal(_ARM.jacobian(strided), _ARM.jacobian(strided.copy()))
+
+
+def test_functional_api_refuses_bad_dtypes_and_nan_reference() -> None:
+    from lynxplan.arm import forward_kinematics, solve_ik_batch, tool_jacobian
+
+    with pytest.raises(InputError, match=r"q must be an array of real numbers"):
+        forward_kinematics(["a"] * 5)
+    with pytest.raises(InputError, match=r"ragged"):
+        tool_jacobian([[0] * 5, [0] * 4])
+    with pytest.raises(InputError, match=r"T must be an array of real numbers"):
+        solve_ik_batch("x")
+    with pytest.raises(NonFiniteInputError, match=r"q_reference"):
+        solve_ik_batch(T0, q_reference=[0, 0, 0, 0, math.nan])  # one (5,) reference too
