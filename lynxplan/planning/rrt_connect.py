@@ -166,7 +166,7 @@ def rrt_connect_kernel(
         length = math.sqrt(length)
         reached = edge_fraction(base, new, model, scratch, clearance)
         parent = other
-        pieces = max(1, int(math.ceil(length / step)))
+        pieces = max(1, math.ceil(length / step))
         for k in range(1, pieces + 1):
             s = k / pieces
             if s > reached:

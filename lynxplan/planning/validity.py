@@ -254,13 +254,11 @@ def _separating_axis_gap(
     for i in range(3):  # axes of box a
         proj = abs(pa[0, i] * t0 + pa[1, i] * t1 + pa[2, i] * t2)
         gap = proj - ha[i] - hb[0] * r[i, 0] - hb[1] * r[i, 1] - hb[2] * r[i, 2]
-        if gap > best:
-            best = gap
+        best = max(best, gap)
     for j in range(3):  # axes of box b
         proj = abs(pb[0, j] * t0 + pb[1, j] * t1 + pb[2, j] * t2)
         gap = proj - hb[j] - ha[0] * r[0, j] - ha[1] * r[1, j] - ha[2] * r[2, j]
-        if gap > best:
-            best = gap
+        best = max(best, gap)
     if best >= EDGE_AXES_BELOW:
         return best
     for i in range(3):  # cross products a_i x b_j, normalised
@@ -278,8 +276,7 @@ def _separating_axis_gap(
                 gap -= ha[k] * abs(l0 * pa[0, k] + l1 * pa[1, k] + l2 * pa[2, k])
                 gap -= hb[k] * abs(l0 * pb[0, k] + l1 * pb[1, k] + l2 * pb[2, k])
             gap /= norm
-            if gap > best:
-                best = gap
+            best = max(best, gap)
     return best
 
 

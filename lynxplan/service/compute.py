@@ -6,6 +6,7 @@ They are plain functions of arrays so that a Dask worker can run them too
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -167,7 +168,7 @@ def trajectory_profiles(
     from lynxplan.trajectory.retime import lspb_profile
 
     profiles = []
-    for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
+    for a, b in itertools.pairwise(waypoints):
         fixed = LspbTiming(*timing) if timing is not None and method == "lspb" else None
         segment = free_segment(a, b, fixed, limits=limits)
         if method == "lspb":

@@ -218,7 +218,7 @@ def execute_run(scenario_path: str, out_dir: str, quick: bool) -> dict[str, Any]
         return {"error": str(exc).splitlines()[0] if str(exc) else type(exc).__name__}
     except MemoryError:
         return {"error": "the run exceeded the worker's memory limit"}
-    except Exception as exc:  # noqa: BLE001 (a run must never take the worker down)
+    except Exception as exc:
         return {"error": f"internal error: {type(exc).__name__}: {exc}".splitlines()[0]}
     out = Path(out_dir)
     report_path = out / "report.json"
@@ -465,7 +465,7 @@ class DaskPool:
             time.sleep(0.05)
         try:
             answer = future.result()
-        except Exception as exc:  # noqa: BLE001 (a lost worker, a cancelled task...)
+        except Exception as exc:
             answer = {"error": f"dask: {type(exc).__name__}: {exc}".splitlines()[0]}
         for name, content in answer.pop("files", {}).items():
             target = job.out_dir / name

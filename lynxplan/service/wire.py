@@ -112,7 +112,7 @@ def as_array(
             array = np.array(value)
         except (ValueError, TypeError):
             raise Problem(422, f"{field} must be a (nested) list of numbers", field) from None
-    if array.dtype.kind not in "iuf" or array.size == 0 and array.ndim == 0:
+    if array.dtype.kind not in "iuf" or (array.size == 0 and array.ndim == 0):
         raise Problem(422, f"{field} must contain numbers only. Got: {_describe(value)}", field)
     expected = str(trailing) if not batch else f"{trailing} or (N, {', '.join(map(str, trailing))})"
     single = array.shape == trailing

@@ -20,7 +20,7 @@ def write_html(scenario: Scenario, result: TaskResult, out_path: Path) -> Path:
     from lynxplan.viz import export_html, tilted_plane
 
     samples, setup = result.samples, result.setup
-    step = max(1, int(round(scenario.sample_rate / PATH_RATE)))
+    step = max(1, round(scenario.sample_rate / PATH_RATE))
     index = np.unique(np.append(np.arange(0, len(samples.t), step), len(samples.t) - 1))
     kinds = [segment.kind for segment in setup.plan.segments]
     plane = None
