@@ -107,3 +107,25 @@ def require_clear(world: CollisionWorld, q: np.ndarray, what: str, clearance: fl
     if distance < clearance:
         raise StateInCollisionError(what, link, obstacle, -distance, clearance)
     return distance
+
+
+def sample_clearances(world: CollisionWorld, q: np.ndarray) -> np.ndarray:
+    """Exact smallest distance over every pair at each sample (branch and bound).
+
+    Pairs whose lower bound (:meth:`CollisionWorld.lower_bounds`) is not below the best exact
+    distance found so far cannot be the minimum and are skipped.
+
+    q: shape (N, nq), in [rad] -> shape (N,), in [m] (inf without pairs).
+    """
+    config = np.atleast_2d(np.asarray(q, dtype=float))
+    poses = world.primitive_poses(config)
+    bounds = world.lower_bounds(poses)
+    result = np.full(len(config), np.inf)
+    for n in range(len(config)):
+        best = np.inf
+        for pair in np.argsort(bounds[n]).tolist():
+            if bounds[n, pair] >= best and bounds[n, pair] > 0:
+                break
+            best = min(best, world.distance(poses[n], pair))
+        result[n] = best
+    return result
