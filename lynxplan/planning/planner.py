@@ -144,7 +144,7 @@ class PlannedTrajectory:
 
     @property
     def min_clearance(self) -> float:
-        """Smallest exact distance along the path, in [m]."""
+        """Smallest exact distance at the waypoints and certification probes, in [m]."""
         return float(self.verification.min_clearance.clearance)
 
 

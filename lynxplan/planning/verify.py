@@ -35,8 +35,11 @@ class VerificationReport:
 
     Attributes:
         collision_free: No contact anywhere along the path, every interval certified.
-        min_clearance: Smallest exact distance over the path (link, obstacle, where), in [m];
-            its ``time`` is the path parameter (waypoint index, fractional between waypoints).
+        min_clearance: Smallest exact distance found at the waypoints and at the points the
+            certification probed between them (link, obstacle, where), in [m]; its ``time`` is
+            the path parameter (waypoint index, fractional between waypoints). In between, the
+            path is certified collision-free, and the planner's own certificate guarantees at
+            least ``required_clearance`` everywhere.
         required_clearance: The planner's required clearance, in [m].
         self_collision_pairs: Number of self-collision pairs checked.
         obstacle_pairs: Number of primitive/obstacle pairs checked.

@@ -34,10 +34,12 @@ goal in collision, or a goal out of reach, is an error naming the link, the obst
 penetration depth.
 
 Metrics: ``solved``, ``collision_free`` (exact verification passed), ``within_limits`` (joint
-position, velocity and acceleration limits at every sample), ``min_clearance`` [m] (exact, over
-the continuous path), ``duration`` [s], ``path_length`` [rad] (joint space), ``nodes``,
-``waypoints``, ``planning_time`` [s] (plan + shortcut + verify). Artifacts: ``trajectory.csv``
-and, unless quick or switched off in ``outputs``, ``clearance.png`` and ``<name>.html``.
+position, velocity and acceleration limits at every sample), ``min_clearance`` [m] (smallest
+exact distance at the samples, the waypoints and the verification's probes; the planner
+certifies the required clearance on the continuous path), ``duration`` [s], ``path_length``
+[rad] (joint space), ``nodes``, ``waypoints``, ``planning_time`` [s] (plan + shortcut + verify).
+Artifacts: ``trajectory.csv`` and, unless quick or switched off in ``outputs``,
+``clearance.png`` and ``<name>.html``.
 """
 
 from __future__ import annotations
@@ -268,7 +270,7 @@ def run(scenario: Input) -> KindOutput:
         "solved": True,
         "collision_free": trajectory.verification.collision_free,
         "within_limits": not limits,
-        "min_clearance": trajectory.min_clearance,
+        "min_clearance": min(trajectory.min_clearance, float(clearances.min())),
         "duration": trajectory.duration,
         "path_length": trajectory.path_length,
         "nodes": trajectory.stats.nodes,
