@@ -45,6 +45,7 @@ Artifacts: ``trajectory.csv`` and, unless quick or switched off in ``outputs``,
 from __future__ import annotations
 
 import re
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal
 
@@ -221,6 +222,47 @@ def planner_options(scenario: Input) -> Any:
     return PlannerOptions(**values)
 
 
+@dataclass(frozen=True)
+class PlanInputs:
+    """A scenario resolved to planner inputs (SI units).
+
+    Attributes:
+        robot: The loaded robot.
+        obstacles: The obstacles.
+        start: Start configuration, shape (nq,), in [rad].
+        goal: The goal (:mod:`lynxplan.planning.problem`).
+        options: Planner options.
+        seed: Random seed.
+        time_limit: Planning time budget, in [s].
+        solvable: Whether the file expects a solution (``expect: {solved: false}`` says not).
+    """
+
+    robot: Any
+    obstacles: list[Any]
+    start: np.ndarray
+    goal: Any
+    options: Any
+    seed: int
+    time_limit: float
+    solvable: bool
+
+
+def plan_inputs(scenario: Input) -> PlanInputs:
+    """The planner inputs of a scenario (loads the robot)."""
+    from lynxplan.scenarios.robot import load_arm_robot
+
+    return PlanInputs(
+        load_arm_robot(scenario.robot),
+        _obstacles(scenario),
+        np.array(scenario.start) * angle_factor(scenario.units.angle),
+        _goal(scenario),
+        planner_options(scenario),
+        scenario.planner.seed,
+        scenario.planner.time_limit,
+        scenario.expect.get("solved", True) is not False,
+    )
+
+
 def run(scenario: Input) -> KindOutput:
     """Plan, verify, time-parameterise; measure limits and per-sample clearance (no files)."""
     import time
@@ -228,19 +270,15 @@ def run(scenario: Input) -> KindOutput:
     from lynxplan.exceptions import PlanningFailed
     from lynxplan.planning import Planner
     from lynxplan.planning.verify import sample_clearances
-    from lynxplan.scenarios.robot import load_arm_robot
 
     began = time.perf_counter()
-    robot = load_arm_robot(scenario.robot)
-    planner = Planner(robot, _obstacles(scenario), planner_options(scenario))
-    start = np.array(scenario.start) * angle_factor(scenario.units.angle)
+    inputs = plan_inputs(scenario)
+    robot = inputs.robot
+    planner = Planner(robot, inputs.obstacles, inputs.options)
     built = time.perf_counter()
     try:
         trajectory = planner.solve(
-            start,
-            _goal(scenario),
-            seed=scenario.planner.seed,
-            time_limit=scenario.planner.time_limit,
+            inputs.start, inputs.goal, seed=inputs.seed, time_limit=inputs.time_limit
         )
     except PlanningFailed as failure:
         metrics = {

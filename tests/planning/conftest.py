@@ -4,7 +4,6 @@ independent dense exact check of a returned trajectory."""
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -32,37 +31,12 @@ SLOW = pytest.mark.skipif(
 )
 
 
-@dataclass(frozen=True)
-class SuiteProblem:
-    """One problem of the suite, resolved to planner inputs (SI)."""
-
-    name: str
-    robot: Any
-    obstacles: list[Any]
-    start: np.ndarray
-    goal: Any
-    options: Any
-    time_limit: float
-    solvable: bool
-
-
-def load_problem(path: Path) -> SuiteProblem:
+def load_problem(path: Path) -> Any:
+    """The planner inputs of a suite file (:class:`lynxplan.scenarios.plan.PlanInputs`)."""
     from lynxplan.scenarios import load_scenario
-    from lynxplan.scenarios import plan as kind
-    from lynxplan.scenarios.robot import load_arm_robot
-    from lynxplan.units import angle_factor
+    from lynxplan.scenarios.plan import plan_inputs
 
-    scenario = load_scenario(path).scenario
-    return SuiteProblem(
-        scenario.name,
-        load_arm_robot(scenario.robot),
-        kind._obstacles(scenario),
-        np.array(scenario.start) * angle_factor(scenario.units.angle),
-        kind._goal(scenario),
-        kind.planner_options(scenario),
-        scenario.planner.time_limit,
-        scenario.expect.get("solved", True) is True,
-    )
+    return plan_inputs(load_scenario(path).scenario)
 
 
 def dense_min_distance(world: CollisionWorld, q: np.ndarray) -> tuple[float, np.ndarray]:
