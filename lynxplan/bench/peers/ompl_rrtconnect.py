@@ -42,9 +42,7 @@ def main() -> None:
                 lambda state, n=nq: valid(np.array([state[j] for j in range(n)]))
             )
             info = setup.getSpaceInformation()
-            info.setStateValidityCheckingResolution(
-                spec["resolution"] / space.getMaximumExtent()
-            )
+            info.setStateValidityCheckingResolution(spec["resolution"] / space.getMaximumExtent())
             start = space.allocState()
             for j in range(nq):
                 start[j] = float(problem["start"][j])
