@@ -229,36 +229,35 @@ def _degrees(theta: tuple[float, ...]) -> str:
     return ", ".join(f"{math.degrees(t):.4f}" for t in theta)
 
 
-class DegenerateForwardKinematicsError(KinematicsError):
-    """Forward kinematics of the 3-RRR has a continuum of solutions (architecture singularity).
+class _ActuatedAnglesError(KinematicsError):
+    """A 3-RRR forward-kinematics problem with given actuated angles.
 
     Attributes:
         theta: The actuated angles, shape (3,), in [rad].
     """
 
-    def __init__(self, theta: tuple[float, float, float]) -> None:
-        self.theta = theta
-        degrees = _degrees(theta)
-        super().__init__(
-            f"parallel robot: the actuated angles ({degrees}) deg leave the platform free to move "
-            "(the closure polynomial vanishes identically); forward kinematics is not finite"
-        )
-
-
-class NoAssemblyModeError(KinematicsError):
-    """The actuated angles of the 3-RRR admit no real assembly mode.
-
-    Attributes:
-        theta: The actuated angles, shape (3,), in [rad].
-    """
+    _problem = ""
 
     def __init__(self, theta: tuple[float, float, float]) -> None:
         self.theta = theta
-        degrees = _degrees(theta)
         super().__init__(
-            f"parallel robot: the actuated angles ({degrees}) deg admit no assembly mode "
-            "(the distal links cannot all meet the platform)"
+            f"parallel robot: the actuated angles ({_degrees(theta)}) deg {self._problem}"
         )
+
+
+class DegenerateForwardKinematicsError(_ActuatedAnglesError):
+    """Forward kinematics of the 3-RRR has a continuum of solutions (architecture singularity)."""
+
+    _problem = (
+        "leave the platform free to move (the closure polynomial vanishes identically); "
+        "forward kinematics is not finite"
+    )
+
+
+class NoAssemblyModeError(_ActuatedAnglesError):
+    """The actuated angles of the 3-RRR admit no real assembly mode."""
+
+    _problem = "admit no assembly mode (the distal links cannot all meet the platform)"
 
 
 class RetimingError(LynxplanError):

@@ -24,11 +24,16 @@ def register(subparsers: Any) -> None:
         action="store_true",
         help="replace --out even if it holds files lynxplan did not write",
     )
+    parser.add_argument("--server", help="run on a lynxplan server (URL) instead of locally")
     parser.set_defaults(handler=handle)
 
 
 def handle(args: argparse.Namespace) -> int:
     """Run the scenario; exit 0 when every expectation holds, 1 otherwise."""
+    if args.server:
+        from lynxplan.client import run_remote
+
+        return run_remote(args.server, args.scenario, args.out, quick=args.quick)
     from lynxplan.scenarios import run_scenario
 
     result = run_scenario(args.scenario, args.out, quick=args.quick, force=args.force)

@@ -7,10 +7,12 @@ and one line here (or a call to :func:`register_kind` from outside the package).
 from __future__ import annotations
 
 import importlib
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from lynxplan.exceptions import ScenarioError
-from lynxplan.scenarios.base import ScenarioKind
+
+if TYPE_CHECKING:  # the registry is read by every CLI start: keep pydantic out of it
+    from lynxplan.scenarios.base import ScenarioKind
 
 #: Scenario kind -> module defining ``NAME``, ``Input``, ``run`` and ``write_outputs``.
 KIND_MODULES: dict[str, str] = {
