@@ -39,7 +39,7 @@ def main() -> None:
             space.setBounds(bounds)
             setup = og.SimpleSetup(space)
             setup.setStateValidityChecker(
-                lambda state, n=nq: valid(np.array([state[j] for j in range(n)]))
+                lambda state, n=nq, check=valid: check(np.array([state[j] for j in range(n)]))
             )
             info = setup.getSpaceInformation()
             info.setStateValidityCheckingResolution(spec["resolution"] / space.getMaximumExtent())
