@@ -108,7 +108,8 @@ def _steps(world: CollisionWorld, waypoints: np.ndarray, step: float) -> np.ndar
     """Pieces of each segment so that no point of the robot moves more than ``step`` [m]."""
     reach = np.stack([p.reach for p in world.links]).max(axis=0)  # (nq,)
     motion = np.abs(np.diff(waypoints, axis=0)) @ reach
-    return np.maximum(1, np.ceil(motion / step)).astype(int)
+    pieces: np.ndarray = np.maximum(1, np.ceil(motion / step)).astype(int)
+    return pieces
 
 
 def densify(world: CollisionWorld, waypoints: np.ndarray, step: float) -> np.ndarray:
@@ -117,7 +118,8 @@ def densify(world: CollisionWorld, waypoints: np.ndarray, step: float) -> np.nda
     waypoints: shape (N, nq), in [rad] -> shape (M, nq), every waypoint kept.
     """
     if len(waypoints) < 2:
-        return waypoints.copy()
+        single: np.ndarray = waypoints.copy()
+        return single
     pieces = [waypoints[:1]]
     for k, count in enumerate(_steps(world, waypoints, step).tolist()):
         s = np.arange(1, count + 1)[:, None] / count
