@@ -79,19 +79,24 @@ def _run_peer(name: str, spec: dict[str, Any]) -> list[dict[str, Any]] | None:
     python = _peer_python(name)
     if python is None:
         return None
+    import tempfile
+
     script = Path(__file__).parent / "peers" / PEERS[name]
-    done = subprocess.run(
-        [str(python), str(script)],
-        input=json.dumps(spec),
-        capture_output=True,
-        text=True,
-        check=False,
-        timeout=3600,
-    )
-    if done.returncode != 0:
-        print(f"peer {name} failed: {done.stderr.strip().splitlines()[-1:]}", file=sys.stderr)
-        return None
-    result: list[dict[str, Any]] = json.loads(done.stdout)
+    with tempfile.TemporaryDirectory() as folder:
+        output = Path(folder) / "results.json"
+        done = subprocess.run(
+            [str(python), str(script), str(output)],
+            input=json.dumps(spec),
+            capture_output=True,
+            text=True,
+            check=False,
+            timeout=3600,
+        )
+        if done.returncode != 0 or not output.is_file():
+            tail = done.stderr.strip().splitlines()[-1:]
+            print(f"peer {name} failed: {tail}", file=sys.stderr)
+            return None
+        result: list[dict[str, Any]] = json.loads(output.read_text(encoding="utf-8"))
     return result
 
 

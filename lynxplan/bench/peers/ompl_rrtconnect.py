@@ -1,10 +1,11 @@
 """Peer: OMPL 2.x RRTConnect through its Python bindings (``ompl.base``/``ompl.geometric``).
 
-Run by the OMPL venv's python: JSON problems on stdin -> JSON results on stdout. Per problem
-and seed: SimpleSetup with a RealVectorStateSpace over the joint limits, a Python validity
-callable using ``pinocchio.computeCollisions`` on the same collision model, the state validity
-checking resolution set to ``resolution`` [rad] (as a fraction of the space's extent), solve,
-then ``simplifySolution``; wall times of both.
+Run by the OMPL venv's python: JSON problems on stdin -> JSON results in the file named by
+argv[1] (stdout carries the logs). Per problem and seed: SimpleSetup with a
+RealVectorStateSpace over the joint limits, a Python validity callable using
+``pinocchio.computeCollisions`` on the same collision model, the state validity checking
+resolution set to ``resolution`` [rad] (as a fraction of the space's extent), solve, then
+``simplifySolution``; wall times of both.
 """
 
 from __future__ import annotations
@@ -80,7 +81,8 @@ def main() -> None:
                     "path": path,
                 }
             )
-    json.dump(results, sys.stdout)
+    with open(sys.argv[1], "w", encoding="utf-8") as out:  # stdout carries the peer's logs
+        json.dump(results, out)
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 """Peer: pyroboplan's RRTPlanner (RRT-Connect, bidirectional) and its shortcut_path.
 
-Run by the pyroboplan venv's python: JSON problems on stdin -> JSON results on stdout. The
+Run by the pyroboplan venv's python: JSON problems on stdin -> JSON results in the file named
+by argv[1] (stdout carries the logs). The
 collision model is the same as lynxplan's (robot + obstacles, non-adjacent self pairs); the
 planner's edge step is ``resolution`` [rad]. pyroboplan takes one goal configuration: the
 first of the problem's goals.
@@ -52,7 +53,8 @@ def main() -> None:
                     "path": [list(map(float, q)) for q in path] if solved else [],
                 }
             )
-    json.dump(results, sys.stdout)
+    with open(sys.argv[1], "w", encoding="utf-8") as out:  # stdout carries the peer's logs
+        json.dump(results, out)
 
 
 if __name__ == "__main__":
