@@ -146,6 +146,7 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         np.empty(nq),
         np.empty((3, 3)),
         np.zeros(3, dtype=np.int64),
+        np.zeros(len(model[4]), dtype=np.int64),
     )
 
 
@@ -278,30 +279,44 @@ def _compose(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
-    """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
-    axes, index_q, parents, joint_placements, prim_joints, prim_placements = model[:6]
-    world, local, rotation, out = scratch[0], scratch[1], scratch[2], scratch[3]
-    joints = joint_placements.shape[0]
+def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
+    """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4).
+
+    The joint rotation is applied to the placement's columns directly (a rotation about one
+    axis mixes two columns), then composed with the parent's pose.
+    """
+    axes, index_q, parents, joint_placements = model[:4]
+    world, local = scratch[0], scratch[1]
     for i in range(4):
         for j in range(4):
             world[0, i, j] = 1.0 if i == j else 0.0
-    for j in range(1, joints):
+    for j in range(1, joint_placements.shape[0]):
         angle = q[index_q[j]]
         c, s = math.cos(angle), math.sin(angle)
         a = axes[j]
         i1, i2 = (a + 1) % 3, (a + 2) % 3
-        rotation[:, :] = 0.0
-        rotation[a, a] = 1.0
-        rotation[3, 3] = 1.0
-        rotation[i1, i1] = c
-        rotation[i2, i2] = c
-        rotation[i1, i2] = -s
-        rotation[i2, i1] = s
-        _compose(joint_placements[j], rotation, local)
+        placement = joint_placements[j]
+        for r in range(3):
+            first, second = placement[r, i1], placement[r, i2]
+            local[r, i1] = c * first + s * second
+            local[r, i2] = c * second - s * first
+            local[r, a] = placement[r, a]
+            local[r, 3] = placement[r, 3]
         _compose(world[parents[j]], local, world[j])
-    for g in range(prim_joints.shape[0]):
-        _compose(world[prim_joints[g]], prim_placements[g], out[g])
+
+
+@numba.njit(cache=True)
+def primitive_pose(g: int, model: Any, scratch: Any) -> None:
+    """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
+    _compose(scratch[0][model[4][g]], model[5][g], scratch[3][g])
+
+
+@numba.njit(cache=True)
+def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
+    """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
+    joint_poses(q, model, scratch)
+    for g in range(model[4].shape[0]):
+        primitive_pose(g, model, scratch)
 
 
 @numba.njit(cache=True)
@@ -427,18 +442,26 @@ def edge_fraction(
         speed[p] = total
     for p in range(pairs.shape[0]):
         certified_until[p] = 0.0
-    counters = scratch[9]
+    counters, fresh = scratch[9], scratch[10]
     counters[0] += 1
+    fresh[:] = 0
     s = 0.0
+    step = 0
     while True:
         counters[1] += 1
+        step += 1
         for j in range(nq):
             q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-        primitive_poses(q, model, scratch)
+        joint_poses(q, model, scratch)
         nearest = np.inf
         for p in range(pairs.shape[0]):
             if certified_until[p] <= s:
                 counters[2] += 1
+                # Primitive poses on demand: most steps re-evaluate one or two pairs.
+                for g in (pairs[p, 0], pairs[p, 1] if pairs[p, 2] == 1 else -1):
+                    if g >= 0 and fresh[g] != step:
+                        primitive_pose(g, model, scratch)
+                        fresh[g] = step
                 slack = pair_bound(p, model, scratch) - clearance
                 if slack <= STALL_DISTANCE:
                     return s if s > 0.0 else -1.0
