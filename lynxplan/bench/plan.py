@@ -189,7 +189,7 @@ def run(quick: bool) -> list[Figure]:
             figures.append(Figure("plan", f"{peer}: not installed (LYNXPLAN_PEERS)", float("nan"),
                                   ""))  # fmt: skip
             continue
-        ok = [r for r in results if r["solved"]]
+        ok = [r for r in results if r["solved"] and np.ndim(r["path"]) == 2 and len(r["path"]) > 1]
         peer_times = [r["plan_time"] + r["simplify_time"] for r in ok]
         peer_lengths = [float(np.linalg.norm(np.diff(r["path"], axis=0), axis=1).sum())
                         for r in ok]  # fmt: skip
