@@ -93,7 +93,7 @@ def test_unreachable_pose_goal(planner: Planner) -> None:
 
 def test_node_budget_ends_the_search_with_the_count(arm: Arm) -> None:
     planner = Planner(arm, [TABLE, WALL], PlannerOptions(max_nodes=5))
-    with pytest.raises(PlanningFailed, match=r"node limit 5 reached after \d+ nodes"):
+    with pytest.raises(PlanningFailed, match=r"after \d+ nodes .*: node limit 5 reached"):
         planner.solve(START, GOAL, seed=0)
 
 
@@ -115,3 +115,23 @@ def test_bad_options_are_input_errors() -> None:
         PlannerOptions(timing="spline")
     with pytest.raises(InputError, match="step"):
         PlannerOptions(step=0.0)
+
+
+def test_a_start_the_checker_cannot_certify_fails_at_once(arm: Arm) -> None:
+    """2.1 mm from a box face ahead of the pen (clear of the 2 mm clearance, so the exact check
+    accepts it) but within the checker's stall margin: PlanningFailed at once, naming the
+    obstacle, not after the time limit."""
+    pose = arm.fk(START)
+    approach = pose[:3, 2]
+    rotation = np.column_stack((pose[:3, 0], pose[:3, 1], approach))
+
+    def block(gap: float) -> BoxObstacle:
+        centre = pose[:3, 3] + (gap + 0.01) * approach
+        return BoxObstacle("block", centre, [0.04, 0.04, 0.02], rotation)
+
+    distance = CollisionWorld(arm, [block(0.05)]).distances(START)[0].min()
+    placed = block(0.05 - (distance - 0.0021))
+    exact = CollisionWorld(arm, [placed]).distances(START)[0].min()
+    assert 0.002 < exact < 0.0022
+    with pytest.raises(PlanningFailed, match=r"after 0 nodes .*start is too close to block"):
+        Planner(arm, [placed]).solve(START, GOAL, time_limit=30.0)
