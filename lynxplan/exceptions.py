@@ -430,14 +430,15 @@ class PlanningFailed(PlanningError):  # noqa: N818 (the name the issue gives)
         nodes: Number of tree nodes created (both trees).
         iterations: Number of sampling iterations.
         elapsed: Planning time spent, in [s].
-        reason: ``"time limit"`` or ``"node limit"`` (with the budget).
+        reason: Why the search stopped: ``"time limit 1 s reached"``, ``"node limit 20000
+            reached"``, or a start/goal the conservative checker cannot certify.
     """
 
     def __init__(self, nodes: int, iterations: int, elapsed: float, reason: str) -> None:
         self.nodes, self.iterations, self.elapsed, self.reason = nodes, iterations, elapsed, reason
         super().__init__(
-            f"no collision-free path found: {reason} reached after {nodes} nodes "
-            f"({iterations} iterations, {elapsed * 1e3:.1f} ms)"
+            f"no collision-free path found after {nodes} nodes "
+            f"({iterations} iterations, {elapsed * 1e3:.1f} ms): {reason}"
         )
 
 

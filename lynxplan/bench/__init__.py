@@ -20,6 +20,7 @@ SECTIONS: dict[str, str] = {
     "collision": "lynxplan.bench.collision",
     "task": "lynxplan.bench.task",
     "cold": "lynxplan.bench.cold",
+    "plan": "lynxplan.bench.plan",
 }
 
 

@@ -254,11 +254,11 @@ def rrt_connect(
             break
         if status == NODE_LIMIT:
             raise PlanningFailed(
-                int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes}"
+                int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes} reached"
             )
         if elapsed >= time_limit:
             raise PlanningFailed(
-                int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s"
+                int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
     from_start = _branch(nodes, parents, 0, int(meta[1]))[::-1]
     to_goal = _branch(nodes, parents, 1, int(meta[2]))
