@@ -304,10 +304,7 @@ def _worker_main(connection: Any, memory_limit: int) -> None:
         import resource
 
         resource.setrlimit(resource.RLIMIT_AS, (memory_limit, memory_limit))
-    import lynxplan.runner  # noqa: F401 (warm imports before the first run)
-    from lynxplan.arm.model import load_arm
-
-    load_arm()
+    _warm_up()
     connection.send("ready")
     while True:
         try:
@@ -315,6 +312,21 @@ def _worker_main(connection: Any, memory_limit: int) -> None:
         except (EOFError, OSError):
             return
         connection.send(execute_run(*message))
+
+
+def _warm_up() -> None:
+    """Import every scenario kind and load the arm before the first run (fast first runs)."""
+    import importlib
+
+    from lynxplan.arm.model import load_arm
+    from lynxplan.scenario import KIND_MODULES
+
+    api = _scenarios_api()
+    modules = getattr(getattr(api, "registry", None), "KIND_MODULES", None) or KIND_MODULES
+    for module in modules.values():
+        with contextlib.suppress(ImportError):
+            importlib.import_module(module)
+    load_arm()
 
 
 def _die_with_parent() -> None:
