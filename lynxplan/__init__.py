@@ -14,14 +14,32 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm
+    from lynxplan.planning.planner import PlannedTrajectory, plan
+    from lynxplan.scenarios.runner import run_scenario
 
-__all__ = ["Arm", "LynxplanError", "__version__", "load_arm"]
+__all__ = [
+    "Arm",
+    "LynxplanError",
+    "PlannedTrajectory",
+    "__version__",
+    "load_arm",
+    "plan",
+    "run_scenario",
+]
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy attributes: ``lynxplan.load_arm`` and ``lynxplan.Arm``."""
+    """Lazy attributes: ``load_arm``, ``Arm``, ``run_scenario``, ``plan``, ``PlannedTrajectory``."""
     if name in ("load_arm", "Arm"):
         from lynxplan.arm import model
 
         return getattr(model, name)
+    if name in ("plan", "PlannedTrajectory"):
+        from lynxplan.planning import planner
+
+        return getattr(planner, name)
+    if name == "run_scenario":
+        from lynxplan.scenarios.runner import run_scenario
+
+        return run_scenario
     raise AttributeError(f"module 'lynxplan' has no attribute {name!r}")
