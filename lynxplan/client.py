@@ -71,6 +71,28 @@ class RunResult:
     artifacts: tuple[str, ...]
     timings: Mapping[str, float]
 
+    @property
+    def result(self) -> Any:
+        """The library's :class:`lynxplan.scenarios.Result`, rebuilt from the run's report
+        (None until the run succeeded)."""
+        from lynxplan.scenarios.base import ExpectationResult, Result
+
+        if self.state != "succeeded" or not isinstance(self.report, Mapping):
+            return None
+        r = self.report
+        return Result(
+            kind=r["kind"],
+            schema_version=r["schema_version"],
+            name=r["name"],
+            inputs=r["inputs"],
+            metrics=r["metrics"],
+            expectations=tuple(ExpectationResult(**e) for e in r["expectations"]),
+            artifacts=tuple(r["artifacts"]),
+            timing=r["timing"],
+            details=r["details"],
+            summary=self.summary or "",
+        )
+
 
 class Client:
     """HTTP client of a lynxplan server.
@@ -411,9 +433,14 @@ def run_remote(url: str, scenario: str | Path, out_dir: str | Path, *, quick: bo
     if result.state != "succeeded":
         raise LynxplanError(f"scenario {scenario}: run {result.id} {result.state}: {result.error}")
     print(result.summary)
+    library = result.result
+    if library is not None and library.expectations:
+        held = sum(e.passed for e in library.expectations)
+        print(f"expectations: {held} of {len(library.expectations)} hold")
+    print(f"outputs in {out_dir}/: {', '.join(result.artifacts)}")
     if not result.ok:
         print("failed expectations:")
-        for failure in (result.error or "").split("; "):
+        for failure in library.failed_expectations if library is not None else ():
             print(f"  - {failure}")
         return 1
     return 0

@@ -257,15 +257,22 @@ def test_trajectory_bad_input(http: httpx.Client) -> None:
 
 # -- runs ---------------------------------------------------------------------------------------
 def test_run_through_the_client_matches_a_local_run(client: Client, tmp_path) -> None:
-    from lynxplan.runner import run_scenario
+    from lynxplan.scenarios import run_scenario
 
     source = SCENARIOS / "free_motion.yaml"
     remote = client.run(source, quick=True, out_dir=tmp_path / "remote")
     local = run_scenario(source, tmp_path / "local", quick=True)
     assert remote.state == "succeeded" and remote.ok is True
     assert remote.summary == local.summary
+    assert set(remote.artifacts) == set(local.artifacts)
     for name in remote.artifacts:
-        assert (tmp_path / "remote" / name).read_bytes() == (tmp_path / "local" / name).read_bytes()
+        if name != "report.json":  # holds wall times
+            assert (tmp_path / "remote" / name).read_bytes() == (
+                tmp_path / "local" / name
+            ).read_bytes()
+    result = remote.result
+    assert result.metrics == orjson.loads(orjson.dumps(dict(local.metrics)))
+    assert result.expectations == local.expectations
     assert remote.timings["run"] > 0
 
 
