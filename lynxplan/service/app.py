@@ -123,6 +123,8 @@ def create_app(config: ServiceConfig) -> FastAPI:
     if config.token:
         app.add_middleware(TokenMiddleware, token=config.token)
 
+    view_lock = asyncio.Lock()
+
     def runs() -> RunManager:
         return state["runs"]
 
@@ -247,6 +249,15 @@ def create_app(config: ServiceConfig) -> FastAPI:
                 "segments": [p._asdict() for p in profiles],
             }
         )
+
+    @app.post("/view", tags=["kinematics"], openapi_extra=openapi_body("FkRequest"))
+    async def view(request: Request) -> Response:
+        body = await json_body(request)
+        arm = get_robot(inputs.robot_name(body))
+        q = wire.as_array(body.get("q"), "q", (5,), batch=False)
+        async with view_lock:  # one meshcat server process at a time
+            html = await asyncio.to_thread(compute.view_html, arm, q)
+        return HTMLResponse(html)
 
     # -- runs ----------------------------------------
     @app.post("/runs", status_code=202, tags=["runs"], openapi_extra=openapi_body("Scenario"))

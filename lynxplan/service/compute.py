@@ -177,3 +177,17 @@ def trajectory_profiles(
         else:
             profiles.append(toppra_profile(segment, limits, rate))
     return profiles
+
+
+def view_html(arm: Any, q: np.ndarray) -> str:
+    """A self-contained meshcat HTML page of the arm at ``q`` (5,) [rad]
+    (:func:`lynxplan.viz.export_html`; no network needed to display it)."""
+    import tempfile
+    from pathlib import Path
+
+    from lynxplan.viz import export_html
+
+    with tempfile.TemporaryDirectory(prefix="lynxplan-view-") as folder:
+        path = export_html(arm, q.reshape(1, 5), np.zeros(1), Path(folder) / "view.html",
+                           autoplay=False)
+        return path.read_text(encoding="utf-8")

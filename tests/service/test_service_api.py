@@ -310,3 +310,10 @@ def test_cancel_a_queued_or_running_run(client: Client) -> None:
     assert client.cancel(first).state == "cancelled"
     after = client.run(SCENARIOS / "free_motion.yaml", quick=True)  # the worker was replaced
     assert after.state == "succeeded"
+
+
+def test_view_is_a_self_contained_meshcat_page(http: httpx.Client) -> None:
+    response = http.post("/view", json={"q": [0.5, 1.0, -1.0, 1.0, 0.3]})
+    assert response.status_code == 200 and response.headers["content-type"].startswith("text/html")
+    assert "meshcat" in response.text.lower() and "<script" in response.text
+    assert_problem(http.post("/view", json={"q": [[0.5, 1.0, -1.0, 1.0, 0.3]]}), 422, "q")
