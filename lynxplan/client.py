@@ -144,15 +144,19 @@ class Client:
         return orjson.loads(self._request(method, path, **kwargs).content)
 
     def _binary(self, path: str, array: np.ndarray, params: dict[str, Any]) -> dict[str, Any]:
-        from lynxplan.service.wire import read_npz
+        from lynxplan.service.wire import read_arrays
 
         response = self._request(
             "POST", path, content=np.ascontiguousarray(array, dtype="<f8").tobytes(),
             params=params, headers={"Content-Type": "application/octet-stream",
                                     "X-Shape": ",".join(map(str, array.shape)),
-                                    "Accept": "application/x-npz"},
+                                    "Accept": "application/x-npy-stream"},
         )  # fmt: skip
-        arrays: dict[str, Any] = read_npz(response.content)
+        arrays: dict[str, Any] = read_arrays(
+            response.content,
+            response.headers.get("content-type", ""),
+            response.headers.get("X-Arrays", ""),
+        )
         arrays.update(orjson.loads(response.headers.get("X-Result", "{}")))
         return arrays
 

@@ -7,6 +7,7 @@ from typing import Any
 
 from lynxplan.bench import SECTIONS, run_sections
 from lynxplan.commands._output import print_json
+from lynxplan.exceptions import InputError
 
 
 def register(subparsers: Any) -> None:
@@ -15,6 +16,9 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--section", action="append", choices=sorted(SECTIONS), help="run only these sections"
     )
+    parser.add_argument(
+        "sections", nargs="*", metavar="SECTION", help="sections to run, e.g. `bench serve`"
+    )
     parser.add_argument("--quick", action="store_true", help="fewer repeats (smoke test)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(handler=handle)
@@ -22,7 +26,10 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the benchmark and print the figures."""
-    figures = run_sections(args.section, quick=args.quick)
+    unknown = sorted(set(args.sections) - set(SECTIONS))
+    if unknown:
+        raise InputError(f"unknown bench section {unknown[0]!r}; sections: {', '.join(SECTIONS)}")
+    figures = run_sections((args.section or []) + args.sections or None, quick=args.quick)
     if args.json:
         print_json({"figures": [f._asdict() for f in figures]})
         return 0

@@ -52,24 +52,29 @@ def ik_single(
 
 
 def ik_batch_arrays(
-    T: np.ndarray, q_reference: np.ndarray | None = None, approach_only: bool = False
+    T: np.ndarray,
+    q_reference: np.ndarray | None = None,
+    approach_only: bool = False,
+    verify: bool = True,
 ) -> dict[str, np.ndarray]:
     """All-branch IK of (N, 4, 4) poses with each branch's FK position residual.
 
     Returns:
-        The fields of the library's ``IkBatch`` plus ``position_error`` (N, 4), in [m]:
-        ``|p_fk(q) - p_target|`` of every branch (NaN where the pose failed).
+        The fields of the library's ``IkBatch`` plus, when ``verify``, ``position_error``
+        (N, 4), in [m]: ``|p_fk(q) - p_target|`` of every branch (NaN where the pose failed).
     """
     from lynxplan.arm.model import load_arm
 
     arm = load_arm()
     batch = arm.ik_batch(T, q_reference=q_reference, approach_only=approach_only)
-    q = batch.q.reshape(-1, 5)
-    failed = ~np.isfinite(q).all(axis=1)
-    reached = arm.fk(np.where(failed[:, None], 0.0, q))[:, :3, 3].reshape(-1, 4, 3)
-    error = np.linalg.norm(reached - T.reshape(-1, 4, 4)[:, None, :3, 3], axis=2)
-    error[failed.reshape(-1, 4)] = np.nan
     out = {name: np.asarray(getattr(batch, name)) for name in batch._fields}
+    if not verify:
+        return out
+    q = np.nan_to_num(batch.q.reshape(-1, 5), nan=0.0)  # failed poses: NaN q, error set below
+    reached = arm.fk(q)[:, :3, 3].reshape(-1, 4, 3)
+    reached -= T.reshape(-1, 4, 4)[:, None, :3, 3]
+    error = np.sqrt(np.einsum("nbi,nbi->nb", reached, reached))
+    error[np.isnan(batch.q[..., 0])] = np.nan
     out["position_error"] = error
     return out
 

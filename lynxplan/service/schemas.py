@@ -74,4 +74,12 @@ def openapi_body(name: str, *, binary: bool = False) -> dict[str, Any]:
         content["application/octet-stream"] = _BINARY
     if name == "Scenario":
         content["application/yaml"] = {"schema": {"type": "string"}}
-    return {"requestBody": {"required": True, "content": content}}
+    extra: dict[str, Any] = {"requestBody": {"required": True, "content": content}}
+    if binary:  # options of binary bodies travel in the query string
+        extra["parameters"] = [
+            {"name": "robot", "in": "query", "schema": {"type": "string", "default": "al5"}},
+            {"name": "approach_only", "in": "query", "schema": {"type": "boolean"}},
+            {"name": "verify", "in": "query", "schema": {"type": "boolean", "default": True},
+             "description": "/ik batches: FK position residual of every branch"},
+        ]  # fmt: skip
+    return extra
