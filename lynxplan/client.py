@@ -293,6 +293,55 @@ class Client:
             for s in answer["segments"]
         ]
 
+    def plan(
+        self,
+        start: Any,
+        goal: Any,
+        obstacles: Sequence[Any] = (),
+        *,
+        seed: int = 0,
+        time_limit: float = 1.0,
+        options: Mapping[str, Any] | None = None,
+        robot: str = "al5",
+    ) -> Any:
+        """Plan on the server, as :func:`lynxplan.planning.plan`: start (5,) [rad], goal (5,)
+        joints or (4, 4) pose [m]; the library's
+        :class:`~lynxplan.planning.PlannedTrajectory`."""
+        from lynxplan.collision import ClearanceRecord
+        from lynxplan.planning import PlannedTrajectory, PlannerOptions, PlanningStats
+        from lynxplan.planning.verify import VerificationReport
+
+        body = {
+            "robot": robot,
+            "start": np.asarray(start, dtype=float),
+            "goal": np.asarray(goal, dtype=float),
+            "obstacles": [_obstacle_json(o) for o in obstacles],
+            "seed": seed,
+            "time_limit": time_limit,
+            "options": dict(options) if options else None,
+        }
+        a = self._json("POST", "/plan", body)
+        v = dict(a["verification"])
+        v["min_clearance"] = ClearanceRecord(
+            **{k: _number(x) for k, x in v["min_clearance"].items()}
+        )
+        option_fields = {k: tuple(x) if isinstance(x, list) else x for k, x in a["options"].items()}
+        return PlannedTrajectory(
+            waypoints=_read_only(np.array(a["waypoints"], dtype=float)),
+            t=_read_only(np.array(a["t"], dtype=float)),
+            q=_read_only(np.array(a["q"], dtype=float)),
+            qd=_read_only(np.array(a["qd"], dtype=float)),
+            qdd=_read_only(np.array(a["qdd"], dtype=float)),
+            segment=_read_only(np.array(a["segment"], dtype=np.asarray(0).dtype)),
+            verification=VerificationReport(**v),
+            goal_label=a["goal_label"],
+            goal_index=a["goal_index"],
+            path_length=a["path_length"],
+            seed=a["seed"],
+            stats=PlanningStats(**a["stats"]),
+            options=PlannerOptions(**option_fields),
+        )  # fmt: skip
+
     # -- runs ----------------------------------------
     def submit(self, scenario: str | Path | Mapping[str, Any], *, quick: bool = False) -> str:
         """Submit a scenario (file path, YAML text or mapping); the run id."""

@@ -230,11 +230,7 @@ def create_app(config: ServiceConfig) -> FastAPI:
         t = None if body.get("t") is None else wire.as_array(body["t"], "t", (), batch=True)
         if t is not None and t.shape != (len(q.reshape(-1, 5)),):
             raise Problem(422, f"t must have shape ({len(q.reshape(-1, 5))},). Got: {t.shape}", "t")
-        specs = inputs.obstacle_specs(body)
-        try:
-            obstacles = compute.build_obstacles(specs)
-        except (KeyError, TypeError) as exc:
-            raise Problem(422, f"obstacle: {str(exc).strip(chr(39))}", "obstacles") from None
+        obstacles = _obstacles(body)
         self_collision = inputs.flag(body, "self_collision")
         result = await asyncio.to_thread(compute.check_arrays, arm, q, t, obstacles, self_collision)
         return wire.json_response(result)
@@ -262,6 +258,29 @@ def create_app(config: ServiceConfig) -> FastAPI:
                 "segments": [p._asdict() for p in profiles],
             }
         )
+
+    @app.post("/plan", tags=["planning"], openapi_extra=openapi_body("PlanRequest"))
+    async def plan(request: Request) -> Response:
+        body = await json_body(request)
+        arm = get_robot(inputs.robot_name(body))
+        start = wire.as_array(body.get("start"), "start", (5,), batch=False)
+        goal_value = body.get("goal")
+        goal_shape = (4, 4) if isinstance(goal_value, list) and goal_value and isinstance(
+            goal_value[0], list) else (5,)  # fmt: skip
+        goal = wire.as_array(goal_value, "goal", goal_shape, batch=False)
+        obstacles = _obstacles(body)
+        seed = int(inputs.number(body, "seed", 0, 0, 2**31 - 1))
+        budget = inputs.number(body, "time_limit", 1.0, 1e-3, compute.MAX_PLAN_TIME)
+        options = body.get("options") or {}
+        if not isinstance(options, dict):
+            raise Problem(422, "options must be an object", "options")
+        try:
+            result = await asyncio.to_thread(
+                compute.plan_json, arm, start, goal, obstacles, seed, budget, options
+            )
+        except TypeError as exc:  # an unknown option name
+            raise Problem(422, f"options: {exc}".split(".__init__()")[-1], "options") from None
+        return wire.json_response(result)
 
     @app.post("/view", tags=["kinematics"], openapi_extra=openapi_body("FkRequest"))
     async def view(request: Request) -> Response:
@@ -399,6 +418,13 @@ def _timing(body: dict[str, Any]) -> tuple[float, float] | None:
         inputs.number(timing, "tt", 0.0, 1e-6, 3600.0),
         inputs.number(timing, "ta", 0.0, 1e-9, 1800.0),
     )
+
+
+def _obstacles(body: dict[str, Any]) -> list[Any]:
+    try:
+        return compute.build_obstacles(inputs.obstacle_specs(body))
+    except (KeyError, TypeError) as exc:
+        raise Problem(422, f"obstacle: {str(exc).strip(chr(39))}", "obstacles") from None
 
 
 def _record(manager: RunManager, run_id: str) -> Any:

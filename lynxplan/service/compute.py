@@ -193,6 +193,40 @@ def view_html(arm: Any, q: np.ndarray) -> str:
     from lynxplan.viz import export_html
 
     with tempfile.TemporaryDirectory(prefix="lynxplan-view-") as folder:
-        path = export_html(arm, q.reshape(1, 5), np.zeros(1), Path(folder) / "view.html",
-                           autoplay=False)
+        path = export_html(
+            arm, q.reshape(1, 5), np.zeros(1), Path(folder) / "view.html", autoplay=False
+        )
         return path.read_text(encoding="utf-8")
+
+
+#: Largest planning time budget one /plan request may ask for, in [s].
+MAX_PLAN_TIME = 30.0
+
+
+def plan_json(
+    arm: Any,
+    start: np.ndarray,
+    goal: np.ndarray,
+    obstacles: list[Any],
+    seed: int,
+    time_limit: float,
+    options: dict[str, Any],
+) -> dict[str, Any]:
+    """:func:`lynxplan.planning.plan` from ``start`` (5,) [rad] to ``goal`` ((5,) joints or
+    (4, 4) tool pose [m]); the trajectory's fields as a JSON-ready mapping."""
+    import dataclasses
+
+    from lynxplan.planning import PlannerOptions, plan
+
+    result = plan(arm, obstacles, start, goal, seed=seed, time_limit=time_limit,
+                  options=PlannerOptions(**options))  # fmt: skip
+    fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
+    verification = dataclasses.asdict(result.verification)
+    verification["min_clearance"] = result.verification.min_clearance._asdict()
+    fields.update(
+        verification=verification,
+        stats=dataclasses.asdict(result.stats),
+        options=dataclasses.asdict(result.options),
+        duration=result.duration,
+    )
+    return fields

@@ -317,3 +317,24 @@ def test_view_is_a_self_contained_meshcat_page(http: httpx.Client) -> None:
     assert response.status_code == 200 and response.headers["content-type"].startswith("text/html")
     assert "meshcat" in response.text.lower() and "<script" in response.text
     assert_problem(http.post("/view", json={"q": [[0.5, 1.0, -1.0, 1.0, 0.3]]}), 422, "q")
+
+
+def test_plan_equals_library(client: Client, http: httpx.Client) -> None:
+    from lynxplan.planning import plan
+
+    arm = load_arm()
+    wall = axis_aligned_box("wall", [0.15, -0.02, -0.1], [0.05, 0.04, 0.3])
+    start = np.array([0.3, 1.2, -1.6, 1.2, 0.5])
+    goal = np.array([2.6, 1.2, -1.6, 1.2, 0.5])
+    remote = client.plan(start, goal, [wall], seed=3, time_limit=5.0)
+    local = plan(arm, [wall], start, goal, seed=3, time_limit=5.0)
+    for name in ("waypoints", "t", "q", "qd", "qdd", "segment"):
+        np.testing.assert_array_equal(getattr(remote, name), getattr(local, name), name)
+    assert remote.verification == local.verification
+    assert (remote.goal_label, remote.path_length, remote.options) == (
+        local.goal_label, local.path_length, local.options)
+    bad = {"start": start.tolist(), "goal": goal.tolist(), "options": {"speed": 1}}
+    assert_problem(http.post("/plan", json=bad), 422, "options")
+    assert_problem(http.post("/plan", json={**bad, "options": {}, "time_limit": 999}), 422,
+                   "time_limit")
+    assert_problem(http.post("/plan", json={"start": [0, 0], "goal": goal.tolist()}), 422, "start")
