@@ -325,7 +325,9 @@ class Client:
         v["min_clearance"] = ClearanceRecord(
             **{k: _number(x) for k, x in v["min_clearance"].items()}
         )
-        option_fields = {k: tuple(x) if isinstance(x, list) else x for k, x in a["options"].items()}
+        option_fields: dict[str, Any] = {
+            k: tuple(x) if isinstance(x, list) else x for k, x in a["options"].items()
+        }
         return PlannedTrajectory(
             waypoints=_read_only(np.array(a["waypoints"], dtype=float)),
             t=_read_only(np.array(a["t"], dtype=float)),
