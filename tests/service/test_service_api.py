@@ -338,3 +338,20 @@ def test_plan_equals_library(client: Client, http: httpx.Client) -> None:
     assert_problem(http.post("/plan", json={**bad, "options": {}, "time_limit": 999}), 422,
                    "time_limit")
     assert_problem(http.post("/plan", json={"start": [0, 0], "goal": goal.tolist()}), 422, "start")
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", sorted(p.name for p in SCENARIOS.glob("*.yaml")))
+def test_every_shipped_scenario_remotely_equals_local(client: Client, tmp_path, name) -> None:
+    from lynxplan.scenarios import run_scenario
+
+    remote = client.run(SCENARIOS / name, quick=True, out_dir=tmp_path / "remote")
+    local = run_scenario(SCENARIOS / name, tmp_path / "local", quick=True)
+    assert remote.state == "succeeded", remote.error
+    assert remote.summary == local.summary and remote.ok == local.ok
+    assert remote.result.metrics == orjson.loads(orjson.dumps(dict(local.metrics),
+                                                              option=orjson.OPT_SERIALIZE_NUMPY))
+    for artifact in local.artifacts:
+        if artifact != "report.json":
+            assert (tmp_path / "remote" / artifact).read_bytes() == (
+                tmp_path / "local" / artifact).read_bytes(), artifact
