@@ -355,3 +355,28 @@ def test_every_shipped_scenario_remotely_equals_local(client: Client, tmp_path, 
         if artifact != "report.json":
             assert (tmp_path / "remote" / artifact).read_bytes() == (
                 tmp_path / "local" / artifact).read_bytes(), artifact
+
+
+def test_cli_run_with_server_and_a_json_scenario(server: Server, client: Client, tmp_path) -> None:
+    import subprocess
+    import sys
+
+    import yaml
+    from conftest import REPO
+
+    done = subprocess.run(
+        [sys.executable, "-m", "lynxplan.cli", "run", "--server", server.url, "--quick",
+         "--out", str(tmp_path / "out"), str(SCENARIOS / "straight_line.yaml")],
+        capture_output=True, text=True, timeout=120, cwd=REPO,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stderr
+    assert "expectations:" in done.stdout and (tmp_path / "out" / "report.json").is_file()
+    mapping = yaml.safe_load((SCENARIOS / "straight_line.yaml").read_text())
+    result = client.run(mapping, quick=True)
+    assert result.state == "succeeded" and result.ok
+    broken = subprocess.run(
+        [sys.executable, "-m", "lynxplan.cli", "run", "--server", "http://127.0.0.1:9",
+         str(SCENARIOS / "straight_line.yaml")],
+        capture_output=True, text=True, timeout=120, cwd=REPO,
+    )  # fmt: skip
+    assert broken.returncode == 2 and broken.stderr.count("\n") == 1, broken.stderr
