@@ -71,27 +71,42 @@ def _request_bytes(path: str, body: bytes) -> bytes:
     )
 
 
-def _latency(port: int, path: str, body: bytes, count: int) -> np.ndarray:
-    """Round-trip times of ``count`` sequential requests on one keep-alive connection, in [ms]
-    (a raw socket client: the figure is the server's, not an HTTP library's)."""
-    request = _request_bytes(path, body)
-    times = np.empty(count + 50)
-    with socket.create_connection(("127.0.0.1", port)) as sock:
+def _round_trip(sock: socket.socket, stream: Any, request: bytes) -> float:
+    start = time.perf_counter()
+    sock.sendall(request)
+    status = stream.readline()
+    length = 0
+    while (line := stream.readline()) != b"\r\n":
+        if line.lower().startswith(b"content-length:"):
+            length = int(line.split(b":")[1])
+    stream.read(length)
+    elapsed = time.perf_counter() - start
+    if not status.startswith(b"HTTP/1.1 200"):
+        raise RuntimeError(f"benchmark request failed: {status.decode().strip()}")
+    return elapsed
+
+
+def _latencies(targets: list[tuple[int, str]], body: bytes, count: int) -> list[np.ndarray]:
+    """Round-trip times, in [ms], of ``count`` sequential requests to each (port, path), one
+    keep-alive connection each, interleaved request by request so that every target sees the
+    same machine load (a raw socket client: the figure is the server's, not an HTTP library's).
+    """
+    connections = []
+    for port, _ in targets:
+        sock = socket.create_connection(("127.0.0.1", port))
         sock.setsockopt(socket.IPPROTO_TCP, socket.TCP_NODELAY, 1)
-        stream = sock.makefile("rb")
+        connections.append((sock, sock.makefile("rb")))
+    requests = [_request_bytes(path, body) for _, path in targets]
+    times = np.empty((len(targets), count + 50))
+    try:
         for i in range(count + 50):
-            start = time.perf_counter()
-            sock.sendall(request)
-            status = stream.readline()
-            length = 0
-            while (line := stream.readline()) != b"\r\n":
-                if line.lower().startswith(b"content-length:"):
-                    length = int(line.split(b":")[1])
-            stream.read(length)
-            times[i] = time.perf_counter() - start
-            if not status.startswith(b"HTTP/1.1 200"):
-                raise RuntimeError(f"{path}: {status.decode().strip()}")
-    return times[50:] * 1e3  # the first 50 warm up
+            for k, ((sock, stream), request) in enumerate(zip(connections, requests, strict=True)):
+                times[k, i] = _round_trip(sock, stream, request)
+    finally:
+        for sock, stream in connections:
+            stream.close()
+            sock.close()
+    return [row[50:] * 1e3 for row in times]  # the first 50 warm up
 
 
 async def _throughput(port: int, path: str, body: bytes, seconds: float) -> float:
@@ -178,9 +193,8 @@ def run(quick: bool) -> list[Figure]:
             service_url + "/health",
         )
         try:
-            bare = _latency(floor_port, "/echo", ik_body, count)
+            bare, ik = _latencies([(floor_port, "/echo"), (service_port, "/ik")], ik_body, count)
             bare_rate = asyncio.run(_throughput(floor_port, "/echo", ik_body, seconds))
-            ik = _latency(service_port, "/ik", ik_body, count)
             rate = asyncio.run(_throughput(service_port, "/ik", ik_body, seconds))
             with httpx.Client(base_url=service_url) as client:
                 poses = arm.fk(

@@ -42,13 +42,13 @@ def ik_single(
 
     Returns:
         The library's ``IkResult`` and ``|p_fk(q) - p_target|`` of the selected solution, in [m]
-        (NaN when no branch is within limits).
+        (the library checks every branch by forward kinematics; NaN when no branch is within
+        limits).
     """
     result = arm.ik(T, q_reference=q_reference, select=select, approach_only=approach_only)
     if result.selected is None:
         return result, float("nan")
-    reached = arm.fk(result.solutions[result.selected].q)
-    return result, float(np.linalg.norm(reached[:3, 3] - T[:3, 3]))
+    return result, float(result.solutions[result.selected].position_error)
 
 
 def ik_batch_arrays(

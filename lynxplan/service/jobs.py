@@ -345,7 +345,11 @@ class _WorkerSlot:
         process.start()
         child.close()
         self._process, self._connection = process, parent
-        if not parent.poll(120) or parent.recv() != "ready":
+        try:
+            ready = parent.poll(120) and parent.recv() == "ready"
+        except (EOFError, OSError):
+            ready = False
+        if not ready:
             self.kill()
             raise RuntimeError("a run worker did not start")
 
