@@ -67,3 +67,19 @@ def test_a_run_over_its_time_limit_fails(guarded: Server) -> None:
         slow = client.run(SCENARIOS / "ok_task.yaml")  # plots and HTML: far over 3 s
         assert slow.state == "failed" and "time limit of 3 s" in slow.error, slow
         assert slow.artifacts == () and slow.timings["total"] < 60
+
+
+@pytest.mark.slow
+def test_a_run_over_its_memory_limit_fails_and_the_next_run_works(tmp_path) -> None:
+    import yaml
+
+    server = Server(tmp_path / "data", "--run-memory", "1.5")
+    try:
+        scenario = yaml.safe_load((SCENARIOS / "workspace.yaml").read_text())
+        scenario.update(samples=50_000_000, report_grid=False)
+        with Client(server.url) as client:
+            big = client.run(scenario, quick=True)
+            assert big.state == "failed" and "memory" in big.error, big
+            assert client.run(SCENARIOS / "straight_line.yaml", quick=True).ok
+    finally:
+        server.stop()
