@@ -32,7 +32,8 @@ def handle(args: argparse.Namespace) -> int:
     """Start the server (blocks until interrupted)."""
     import uvicorn
 
-    from lynxplan.service.app import ServiceConfig, create_app
+    from lynxplan.service.app import create_app
+    from lynxplan.service.config import ServiceConfig
 
     token = _read_token(args.token_file)
     if token is None and not _is_loopback(args.host):

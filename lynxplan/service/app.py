@@ -4,15 +4,12 @@
 from __future__ import annotations
 
 import asyncio
-import hmac
 import mimetypes
 import platform
 import time
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
-from dataclasses import dataclass
 from importlib import resources
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -20,20 +17,18 @@ from fastapi import FastAPI, Query, Request
 from fastapi.exceptions import RequestValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import FileResponse, HTMLResponse, Response
-from starlette.types import ASGIApp, Receive, Scope, Send
 
 from lynxplan import __version__
 from lynxplan.exceptions import LynxplanError
 from lynxplan.service import compute, inputs, wire
+from lynxplan.service.auth import TokenMiddleware
+from lynxplan.service.config import ServiceConfig
 from lynxplan.service.jobs import FINAL_STATES, RunManager, validate_scenario
 from lynxplan.service.problems import Problem, problem_response
 from lynxplan.service.robots import describe_robot, get_robot, robot_names
 from lynxplan.service.schemas import openapi_body
 
 API_VERSION = 1
-#: Paths answered without a token: the liveness probe and the (data-free) web page.
-PUBLIC_PATHS = ("/health", "/", "/favicon.ico")
-PUBLIC_PREFIXES = ("/static/",)
 #: Hot routes served by plain Starlette routes in front of their FastAPI twins (see
 #: :func:`_fast_routes`); each endpoint takes only the request.
 FAST_PATHS = ("/ik", "/fk", "/check", "/trajectory")
@@ -47,59 +42,6 @@ SCENARIO_MEDIA_TYPES = (
     "text/x-yaml",
     "text/plain",
 )
-
-
-@dataclass(frozen=True)
-class ServiceConfig:
-    """Server settings.
-
-    Attributes:
-        data_dir: Job store and artifacts folder.
-        workers: Run worker processes.
-        token: Bearer token required on every request but /health (None: no check).
-        max_body: Largest request body, in [bytes].
-        max_batch: Largest batch (poses / configurations) in one request.
-        max_json_batch: Largest batch in a JSON body (larger ones must be binary).
-        dask_scheduler: Dask scheduler address, or None for the local pool.
-        dask_batch: /ik batches at least this large go to Dask when configured.
-        run_timeout: Wall-clock limit of one run, in [s].
-        run_memory: Address-space limit of a run worker, in [bytes] (0: none).
-    """
-
-    data_dir: Path
-    workers: int = 1
-    token: str | None = None
-    max_body: int = 64 * 1024**2
-    max_batch: int = 1_000_000
-    max_json_batch: int = 20_000
-    dask_scheduler: str | None = None
-    dask_batch: int = 50_000
-    run_timeout: float = 600.0
-    run_memory: int = 8 * 1024**3
-    max_scenario: int = 1024**2
-
-
-class TokenMiddleware:
-    """Bearer-token check (constant time) on every request except :data:`PUBLIC_PATHS`."""
-
-    def __init__(self, app: ASGIApp, token: str) -> None:
-        self.app = app
-        self.expected = f"Bearer {token}".encode()
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        path = scope.get("path", "")
-        if scope["type"] != "http" or path in PUBLIC_PATHS or path.startswith(PUBLIC_PREFIXES):
-            await self.app(scope, receive, send)
-            return
-        presented = b""
-        for key, value in scope["headers"]:
-            if key == b"authorization":
-                presented = value
-        if not hmac.compare_digest(presented, self.expected):
-            detail = "missing bearer token" if not presented else "invalid bearer token"
-            await problem_response(401, detail, "Authorization", path)(scope, receive, send)
-            return
-        await self.app(scope, receive, send)
 
 
 def create_app(config: ServiceConfig) -> FastAPI:
