@@ -255,15 +255,22 @@ def execute_run_packed(source: str, quick: bool) -> dict[str, Any]:
 def validate_scenario(source: str) -> tuple[str, str]:
     """Validate scenario text (YAML or JSON) without running it; its (kind, name).
 
+    A scenario sent over the network may not name files on the server: a ``robot.urdf`` path
+    is refused (built-in robot names only).
+
     Raises:
         lynxplan.exceptions.ScenarioError: naming the key path and the reason.
     """
+    from lynxplan.exceptions import ScenarioError
+    from lynxplan.scenarios import load_scenario
+
     with tempfile.TemporaryDirectory(prefix="lynxplan-check-") as folder:
         path = Path(folder) / "scenario.yaml"
         path.write_text(source, encoding="utf-8")
-        from lynxplan.scenarios import load_scenario
-
         scenario = load_scenario(path).scenario
+    if getattr(getattr(scenario, "robot", None), "urdf", None) is not None:
+        raise ScenarioError("<request>", "robot.urdf", "the service runs built-in robots only "
+                            "(robot: {name: ...}); it does not read URDF paths on its disk")
     return str(getattr(scenario, "kind", "")), str(getattr(scenario, "name", "") or "")
 
 

@@ -4,6 +4,7 @@ gets the right status and an RFC 9457 problem naming the field, never a tracebac
 from __future__ import annotations
 
 import io
+import re
 
 import httpx
 import numpy as np
@@ -299,6 +300,10 @@ def test_bad_scenarios_are_rejected_before_running(http: httpx.Client) -> None:
     assert_problem(http.post("/runs", content=b"kind: [unclosed", headers=yaml), 422)
     assert_problem(http.post("/runs", content=b"{bad json", headers={"Content-Type":
                                                                      "application/json"}), 422)
+    task = (SCENARIOS / "ok_task.yaml").read_text()
+    with_urdf = re.sub(r"(?m)^robot: \{\}", "robot: {urdf: /etc/hostname}", task, count=1)
+    assert with_urdf != task
+    assert_problem(http.post("/runs", content=with_urdf.encode(), headers=yaml), 422, "robot.urdf")
     assert_problem(http.post("/runs", content=b"\x00\x01", headers={"Content-Type":
                                                                     "image/png"}), 415)
 
