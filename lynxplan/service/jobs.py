@@ -269,8 +269,12 @@ def validate_scenario(source: str) -> tuple[str, str]:
         path.write_text(source, encoding="utf-8")
         scenario = load_scenario(path).scenario
     if getattr(getattr(scenario, "robot", None), "urdf", None) is not None:
-        raise ScenarioError("<request>", "robot.urdf", "the service runs built-in robots only "
-                            "(robot: {name: ...}); it does not read URDF paths on its disk")
+        raise ScenarioError(
+            "<request>",
+            "robot.urdf",
+            "the service runs built-in robots only "
+            "(robot: {name: ...}); it does not read URDF paths on its disk",
+        )
     return str(getattr(scenario, "kind", "")), str(getattr(scenario, "name", "") or "")
 
 
