@@ -10,7 +10,7 @@ import httpx
 import numpy as np
 import orjson
 import pytest
-from conftest import SCENARIOS, Server
+from service_server import SCENARIOS, Server
 
 from lynxplan.arm import load_arm
 from lynxplan.client import Client, ServiceError
@@ -367,7 +367,7 @@ def test_cli_run_with_server_and_a_json_scenario(server: Server, client: Client,
     import sys
 
     import yaml
-    from conftest import REPO
+    from service_server import REPO
 
     done = subprocess.run(
         [sys.executable, "-m", "lynxplan.cli", "run", "--server", server.url, "--quick",

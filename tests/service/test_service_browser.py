@@ -12,7 +12,7 @@ from urllib.parse import urlencode
 import numpy as np
 import pytest
 from browser import CHROMIUM
-from conftest import SCENARIOS, Server
+from service_server import SCENARIOS, Server
 
 from lynxplan.arm import load_arm
 

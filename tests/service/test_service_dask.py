@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from conftest import SCENARIOS, Server
+from service_server import SCENARIOS, Server
 
 from lynxplan.arm import load_arm
 from lynxplan.client import Client

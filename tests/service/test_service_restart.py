@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import time
 
-from conftest import SCENARIOS, Server
+from service_server import SCENARIOS, Server
 
 from lynxplan.client import Client
 from lynxplan.service.jobs import JobStore

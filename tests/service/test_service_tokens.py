@@ -7,7 +7,7 @@ import sys
 
 import httpx
 import pytest
-from conftest import REPO, SCENARIOS, Server
+from service_server import REPO, SCENARIOS, Server
 
 from lynxplan.client import Client, ServiceError
 
