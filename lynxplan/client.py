@@ -365,9 +365,10 @@ class Client:
         )
         return str(answer["id"])
 
-    def status(self, run_id: str) -> RunResult:
-        """The run's current record."""
-        fields = self._json("GET", f"/runs/{run_id}")
+    def status(self, run_id: str, wait: float = 0.0) -> RunResult:
+        """The run's current record; with ``wait`` [s], the server holds the answer until the
+        run ends or that time passed (long poll)."""
+        fields = self._json("GET", f"/runs/{run_id}", params={"wait": wait} if wait else None)
         return RunResult(
             fields["id"],
             fields["state"],
@@ -379,13 +380,12 @@ class Client:
             fields["timings"],
         )
 
-    def wait(self, run_id: str, timeout: float = 3600.0, poll: float = 0.05) -> RunResult:
-        """Poll until the run ends (``timeout`` in [s])."""
+    def wait(self, run_id: str, timeout: float = 3600.0) -> RunResult:
+        """Wait until the run ends (``timeout`` in [s]), by long polls of at most 10 s."""
         deadline = time.monotonic() + timeout
-        while (result := self.status(run_id)).state not in _FINAL:
+        while (result := self.status(run_id, wait=min(10.0, timeout))).state not in _FINAL:
             if time.monotonic() > deadline:
                 raise ServiceError(0, f"run {run_id} did not end within {timeout:g} s")
-            time.sleep(poll)
         return result
 
     def cancel(self, run_id: str) -> RunResult:

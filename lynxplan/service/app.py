@@ -32,6 +32,8 @@ API_VERSION = 1
 #: Hot routes served by plain Starlette routes in front of their FastAPI twins (see
 #: :func:`_fast_routes`); each endpoint takes only the request.
 FAST_PATHS = ("/ik", "/fk", "/check", "/trajectory")
+#: Period of the store checks of a long-polling GET /runs/{id}?wait=..., in [s].
+RUN_POLL = 0.005
 #: Batches at least this large are solved off the event loop (or on Dask when configured).
 THREAD_BATCH = 2_000
 SCENARIO_MEDIA_TYPES = (
@@ -270,8 +272,21 @@ def create_app(config: ServiceConfig) -> FastAPI:
         )
 
     @app.get("/runs/{run_id}", tags=["runs"])
-    async def get_run(run_id: str) -> Response:
-        return wire.json_response(_record(runs(), run_id).as_json())
+    async def get_run(
+        run_id: str,
+        wait: float = Query(
+            0.0,
+            ge=0.0,
+            le=60.0,
+            description="Long poll: wait up to this many seconds for the run to end, in s.",
+        ),
+    ) -> Response:
+        record = _record(runs(), run_id)
+        deadline = time.monotonic() + wait
+        while record.state not in FINAL_STATES and time.monotonic() < deadline:
+            await asyncio.sleep(RUN_POLL)
+            record = _record(runs(), run_id)
+        return wire.json_response(record.as_json())
 
     @app.delete("/runs/{run_id}", tags=["runs"])
     async def cancel_run(run_id: str) -> Response:

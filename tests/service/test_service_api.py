@@ -385,3 +385,13 @@ def test_cli_run_with_server_and_a_json_scenario(server: Server, client: Client,
         capture_output=True, text=True, timeout=120, cwd=REPO,
     )  # fmt: skip
     assert broken.returncode == 2 and broken.stderr.count("\n") == 1, broken.stderr
+
+
+def test_long_poll_returns_when_the_run_ends(http: httpx.Client, client: Client) -> None:
+    import time
+
+    run_id = client.submit(SCENARIOS / "straight_line.yaml", quick=True)
+    start = time.monotonic()
+    record = http.get(f"/runs/{run_id}", params={"wait": 60}).json()
+    assert record["state"] == "succeeded" and time.monotonic() - start < 30
+    assert_problem(http.get(f"/runs/{run_id}", params={"wait": 61}), 422, "wait")
