@@ -110,8 +110,7 @@ async function runScenario(text) {
     $("run-state").textContent = record.state;
     $("run-progress").value = record.progress;
     if (["succeeded", "failed", "cancelled", "interrupted"].includes(record.state)) break;
-    await new Promise((resolve) => setTimeout(resolve, 250));
-    record = await api("GET", "/runs/" + record.id);
+    record = await api("GET", "/runs/" + record.id + "?wait=2");  // long poll
   }
   $("run-state").dataset.id = record.id;
   if (record.state !== "succeeded") { show("run-summary", record.error || record.state, true); return record; }
