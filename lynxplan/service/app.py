@@ -66,6 +66,8 @@ def create_app(config: ServiceConfig) -> FastAPI:
         version=__version__,
         lifespan=lifespan,
         description="Kinematics, collision checks, trajectories and scenario runs.",
+        docs_url=None,  # FastAPI's Swagger page loads its assets from a CDN: served below
+        redoc_url=None,
     )
     _install_error_handlers(app)
     if config.token:
@@ -310,6 +312,10 @@ def create_app(config: ServiceConfig) -> FastAPI:
     @app.get("/", include_in_schema=False)
     async def page() -> Response:
         return HTMLResponse(_static("index.html").decode())
+
+    @app.get("/docs", include_in_schema=False)
+    async def docs() -> Response:
+        return HTMLResponse(_static("docs.html").decode())
 
     @app.get("/static/{name}", include_in_schema=False)
     async def static(name: str) -> Response:

@@ -8,8 +8,8 @@ from starlette.types import ASGIApp, Receive, Scope, Send
 
 from lynxplan.service.problems import problem_response
 
-#: Paths answered without a token: the liveness probe and the (data-free) web page.
-PUBLIC_PATHS = ("/health", "/", "/favicon.ico")
+#: Paths answered without a token: the liveness probe and the (data-free) web pages.
+PUBLIC_PATHS = ("/health", "/", "/docs", "/favicon.ico")
 PUBLIC_PREFIXES = ("/static/",)
 
 

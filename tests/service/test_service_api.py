@@ -73,7 +73,10 @@ def test_openapi_document_and_docs(http: httpx.Client) -> None:
         assert path in spec["paths"], path
     ik_body = spec["paths"]["/ik"]["post"]["requestBody"]["content"]
     assert {"application/json", "application/x-npy", "application/octet-stream"} <= set(ik_body)
-    assert "swagger" in http.get("/docs").text.lower()
+    docs = http.get("/docs")
+    assert docs.status_code == 200 and "/static/docs.js" in docs.text
+    assert not re.search(r"(https?:)?//[a-z0-9.-]+\.[a-z]{2,}/", docs.text)  # no CDN
+    assert http.get("/redoc").status_code == 404
 
 
 def test_unknown_route_and_method(http: httpx.Client) -> None:

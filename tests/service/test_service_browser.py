@@ -52,18 +52,31 @@ class _Elements(HTMLParser):
                 break
 
 
+def dump_dom(url: str, profile) -> str:
+    """The DOM of ``url`` after its scripts ran (headless Chromium, virtual time)."""
+    command = [
+        str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+        "--disable-background-networking", "--disable-component-update", "--disable-sync",
+        f"--user-data-dir={profile}", "--virtual-time-budget=900000", "--dump-dom", url,
+    ]  # fmt: skip
+    return subprocess.run(command, capture_output=True, text=True, timeout=240, check=True).stdout
+
+
+def test_api_docs_render_offline(server: Server, tmp_path) -> None:
+    page = _Elements()
+    page.feed(dump_dom(f"{server.url}/docs", tmp_path / "profile"))
+    assert page.body.get("data-rendered") == "yes"
+    text = page.by_id["endpoints"]["text"]
+    for path in ("/ik", "/fk", "/check", "/trajectory", "/plan", "/runs"):
+        assert path in text, path
+
+
 def test_page_fk_ik_and_a_run_with_plots(server: Server, tmp_path) -> None:
     q_deg = [40.0, 70.0, -80.0, 60.0, 30.0]
     params = {"demo": "1", "q": ",".join(map(str, q_deg)),
               "scenario": (SCENARIOS / "free_motion.yaml").read_text()}  # fmt: skip
     url = f"{server.url}/?{urlencode(params)}"
-    command = [
-        str(CHROMIUM), "--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
-        "--disable-background-networking", "--disable-component-update", "--disable-sync",
-        f"--user-data-dir={tmp_path / 'profile'}", "--virtual-time-budget=900000",
-        "--dump-dom", url,
-    ]  # fmt: skip
-    dom = subprocess.run(command, capture_output=True, text=True, timeout=240, check=True).stdout
+    dom = dump_dom(url, tmp_path / "profile")
     page = _Elements()
     page.feed(dom)
     assert page.body.get("data-demo") == "done", dom[-3000:]
