@@ -25,6 +25,11 @@ from lynxplan.trajectory import MotionLimits, free_segment, ruckig_profile, topp
 from lynxplan.trajectory.retime import lspb_profile
 
 PROBLEM = "application/problem+json"
+#: The orientation residuals of the IK kernels differ in their last bits (~1e-17 rad) between a
+#: process that JIT-compiles the numba kernel and one that loads it from numba's cache (the
+#: server and this process are two processes): those fields are compared to this, the rest bit
+#: for bit. (A library property, reproduced without the service; see the service report.)
+ORIENTATION_ATOL = 1e-15
 RNG = np.random.default_rng(15)
 
 
@@ -100,10 +105,13 @@ def test_ik_single_equals_library(client: Client, http: httpx.Client) -> None:
         T = arm.fk(q)
         remote, local = client.ik(T, q_reference=q), arm.ik(T, q_reference=q)
         assert remote.selected == local.selected
-        assert remote.orientation_residual == local.orientation_residual
+        assert remote.orientation_residual == pytest.approx(
+            local.orientation_residual, abs=ORIENTATION_ATOL
+        )
         for a, b in zip(remote.solutions, local.solutions, strict=True):
             np.testing.assert_array_equal(a.q, b.q)
-            assert a[1:] == b[1:]
+            assert a[1:4] == b[1:4]
+            assert a.orientation_error == pytest.approx(b.orientation_error, abs=ORIENTATION_ATOL)
     answer = http.post("/ik", json={"T": arm.fk(q).tolist()}).json()
     assert answer["position_residual"] < 1e-12 and answer["branch"]
 
@@ -117,12 +125,21 @@ def test_ik_batch_json_and_binary_equal_library(client: Client, http: httpx.Clie
         remote = client.ik(poses)
         expected = arm.ik_batch(poses)
         for name in expected._fields:
-            np.testing.assert_array_equal(getattr(remote, name), getattr(expected, name), name)
+            if name == "orientation_error":
+                np.testing.assert_allclose(
+                    remote.orientation_error,
+                    expected.orientation_error,
+                    rtol=0,
+                    atol=ORIENTATION_ATOL,
+                )
+            else:
+                np.testing.assert_array_equal(getattr(remote, name), getattr(expected, name), name)
     assert local.status[7] != 0
     npy = io.BytesIO()
     np.save(npy, T[:100])
-    answer = http.post("/ik", content=npy.getvalue(),
-                       headers={"Content-Type": "application/x-npy"}).json()
+    answer = http.post(
+        "/ik", content=npy.getvalue(), headers={"Content-Type": "application/x-npy"}
+    ).json()
     assert answer["count"] == 100
     assert np.nanmax(np.array(answer["position_error"], dtype=float)) < 1e-9
 
@@ -149,8 +166,7 @@ def test_ik_position_and_approach_target(http: httpx.Client) -> None:
         (b'{"T": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, null]]}', "T"),
         (b'{"T": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, "1"]]}', "T"),
         (b'{"T": [[1, 0, 0, 1e999], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}', "body"),
-        (b'{"T": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "select": 3}',
-         "select"),
+        (b'{"T": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "select": 3}', "select"),
         (b'{"position": [0.2, 0, 0.1], "approach": [0, 0, 0]}', "approach"),
         (b'{"q_reference": [0, 0]}', "T"),
     ],
@@ -173,32 +189,39 @@ def test_binary_bodies_are_checked(http: httpx.Client) -> None:
     raw = np.zeros((10, 4, 4)).tobytes()
     headers = {"Content-Type": "application/octet-stream"}
     assert_problem(http.post("/ik", content=raw, headers=headers), 422, "X-Shape")
-    assert_problem(http.post("/ik", content=raw, headers={**headers, "X-Shape": "9,4,4"}), 422,
-                   "X-Shape")
-    assert_problem(http.post("/ik", content=raw, headers={**headers, "X-Shape": "10,4,a"}),
-                   422, "X-Shape")
-    assert_problem(http.post("/ik", content=b"not npy", headers={"Content-Type":
-                                                                 "application/x-npy"}), 422, "T")
+    assert_problem(
+        http.post("/ik", content=raw, headers={**headers, "X-Shape": "9,4,4"}), 422, "X-Shape"
+    )
+    assert_problem(
+        http.post("/ik", content=raw, headers={**headers, "X-Shape": "10,4,a"}), 422, "X-Shape"
+    )
+    assert_problem(
+        http.post("/ik", content=b"not npy", headers={"Content-Type": "application/x-npy"}),
+        422,
+        "T",
+    )
     bad = np.full((2, 4, 4), np.nan)
-    assert_problem(http.post("/ik", content=bad.tobytes(), headers={**headers,
-                                                                     "X-Shape": "2,4,4"}), 422)
+    assert_problem(
+        http.post("/ik", content=bad.tobytes(), headers={**headers, "X-Shape": "2,4,4"}), 422
+    )
 
 
 def test_huge_bodies_and_batches_are_413(http: httpx.Client) -> None:
     big = b"0" * (2 * 1024**2)  # the session server takes at most 1 MiB
-    assert_problem(http.post("/fk", content=big, headers={"Content-Type": "application/json"}),
-                   413)
+    assert_problem(http.post("/fk", content=big, headers={"Content-Type": "application/json"}), 413)
 
     def chunks():
         for _ in range(40):
             yield b" " * 65536  # no Content-Length: counted while streaming
 
-    assert_problem(http.post("/fk", content=chunks(), headers={"Content-Type":
-                                                               "application/json"}), 413)
+    assert_problem(
+        http.post("/fk", content=chunks(), headers={"Content-Type": "application/json"}), 413
+    )
     many = orjson.dumps({"q": np.zeros((25_000, 5)).tolist()})
     assert len(many) < 1024**2
-    assert_problem(http.post("/fk", content=many, headers={"Content-Type":
-                                                           "application/json"}), 413, "q")
+    assert_problem(
+        http.post("/fk", content=many, headers={"Content-Type": "application/json"}), 413, "q"
+    )
 
 
 def test_unreachable_and_domain_errors_are_422(client: Client) -> None:
@@ -212,8 +235,10 @@ def test_unreachable_and_domain_errors_are_422(client: Client) -> None:
 # -- collision and trajectories ------------------------------------------------------------------
 def test_check_configurations_and_trajectory_equal_library(client: Client) -> None:
     arm = load_arm()
-    obstacles = [SphereObstacle("ball", [0.25, 0.05, 0.0], 0.04),
-                 axis_aligned_box("wall", [0.1, -0.3, -0.2], [0.3, 0.05, 0.4])]
+    obstacles = [
+        SphereObstacle("ball", [0.25, 0.05, 0.0], 0.04),
+        axis_aligned_box("wall", [0.1, -0.3, -0.2], [0.3, 0.05, 0.4]),
+    ]
     world = CollisionWorld(arm, obstacles)
     q = np.linspace([0.3, 0.8, -1.4, 1.0, 0.2], [1.4, 1.2, -0.8, 1.6, 1.0], 40)
     t = np.linspace(0.0, 2.0, 40)
@@ -232,8 +257,9 @@ def test_check_bad_obstacle(http: httpx.Client) -> None:
 @pytest.mark.parametrize("method", ["lspb", "ruckig", "toppra"])
 def test_trajectory_equals_library(client: Client, method: str) -> None:
     arm = load_arm()
-    waypoints = np.array([[0.2, 0.5, -0.5, 0.3, 0.2], [1.0, 1.0, -1.0, 1.0, 0.5],
-                          [0.5, 0.6, -0.3, 0.2, 0.9]])
+    waypoints = np.array(
+        [[0.2, 0.5, -0.5, 0.3, 0.2], [1.0, 1.0, -1.0, 1.0, 0.5], [0.5, 0.6, -0.3, 0.2, 0.9]]
+    )
     limits = MotionLimits.from_joint_limits(arm.limits)
     remote = client.trajectory(waypoints, method, rate=50.0)
     for profile, a, b in zip(remote, waypoints[:-1], waypoints[1:], strict=True):
@@ -255,8 +281,9 @@ def test_trajectory_bad_input(http: httpx.Client) -> None:
     assert_problem(http.post("/trajectory", json={**two, "method": "spline"}), 422, "method")
     assert_problem(http.post("/trajectory", json={**two, "rate": 1e9}), 422, "rate")
     assert_problem(http.post("/trajectory", json={**two, "timing": {"tt": 1.0, "ta": 0.9}}), 422)
-    assert_problem(http.post("/trajectory", json={**two, "limits": {"speed": 1}}), 422,
-                   "limits.speed")
+    assert_problem(
+        http.post("/trajectory", json={**two, "limits": {"speed": 1}}), 422, "limits.speed"
+    )
 
 
 # -- runs ---------------------------------------------------------------------------------------
@@ -296,19 +323,22 @@ def test_run_listing_artifacts_and_errors(http: httpx.Client, client: Client) ->
 
 def test_bad_scenarios_are_rejected_before_running(http: httpx.Client) -> None:
     yaml = {"Content-Type": "application/yaml"}
-    assert_problem(http.post("/runs", content=b"kind: nothing\nname: x\n", headers=yaml), 422,
-                   "kind")
+    assert_problem(
+        http.post("/runs", content=b"kind: nothing\nname: x\n", headers=yaml), 422, "kind"
+    )
     body = (SCENARIOS / "free_motion.yaml").read_text().replace("tt: 3.0", "tt: -3.0")
     assert_problem(http.post("/runs", content=body.encode(), headers=yaml), 422)
     assert_problem(http.post("/runs", content=b"kind: [unclosed", headers=yaml), 422)
-    assert_problem(http.post("/runs", content=b"{bad json", headers={"Content-Type":
-                                                                     "application/json"}), 422)
+    assert_problem(
+        http.post("/runs", content=b"{bad json", headers={"Content-Type": "application/json"}), 422
+    )
     task = (SCENARIOS / "ok_task.yaml").read_text()
     with_urdf = re.sub(r"(?m)^robot: \{\}", "robot: {urdf: /etc/hostname}", task, count=1)
     assert with_urdf != task
     assert_problem(http.post("/runs", content=with_urdf.encode(), headers=yaml), 422, "robot.urdf")
-    assert_problem(http.post("/runs", content=b"\x00\x01", headers={"Content-Type":
-                                                                    "image/png"}), 415)
+    assert_problem(
+        http.post("/runs", content=b"\x00\x01", headers={"Content-Type": "image/png"}), 415
+    )
 
 
 def test_cancel_a_queued_or_running_run(client: Client) -> None:
@@ -340,11 +370,15 @@ def test_plan_equals_library(client: Client, http: httpx.Client) -> None:
         np.testing.assert_array_equal(getattr(remote, name), getattr(local, name), name)
     assert remote.verification == local.verification
     assert (remote.goal_label, remote.path_length, remote.options) == (
-        local.goal_label, local.path_length, local.options)
+        local.goal_label,
+        local.path_length,
+        local.options,
+    )
     bad = {"start": start.tolist(), "goal": goal.tolist(), "options": {"speed": 1}}
     assert_problem(http.post("/plan", json=bad), 422, "options")
-    assert_problem(http.post("/plan", json={**bad, "options": {}, "time_limit": 999}), 422,
-                   "time_limit")
+    assert_problem(
+        http.post("/plan", json={**bad, "options": {}, "time_limit": 999}), 422, "time_limit"
+    )
     assert_problem(http.post("/plan", json={"start": [0, 0], "goal": goal.tolist()}), 422, "start")
 
 
@@ -357,12 +391,14 @@ def test_every_shipped_scenario_remotely_equals_local(client: Client, tmp_path, 
     local = run_scenario(SCENARIOS / name, tmp_path / "local", quick=True)
     assert remote.state == "succeeded", remote.error
     assert remote.summary == local.summary and remote.ok == local.ok
-    assert remote.result.metrics == orjson.loads(orjson.dumps(dict(local.metrics),
-                                                              option=orjson.OPT_SERIALIZE_NUMPY))
+    assert remote.result.metrics == orjson.loads(
+        orjson.dumps(dict(local.metrics), option=orjson.OPT_SERIALIZE_NUMPY)
+    )
     for artifact in local.artifacts:
         if artifact != "report.json":
             assert (tmp_path / "remote" / artifact).read_bytes() == (
-                tmp_path / "local" / artifact).read_bytes(), artifact
+                tmp_path / "local" / artifact
+            ).read_bytes(), artifact
 
 
 def test_cli_run_with_server_and_a_json_scenario(server: Server, client: Client, tmp_path) -> None:

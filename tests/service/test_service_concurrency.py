@@ -65,8 +65,11 @@ def _same(a: object, b: object) -> bool:
     from lynxplan.arm.model import IkResult
 
     assert isinstance(a, IkResult) and isinstance(b, IkResult)
-    return (a.selected == b.selected and a.orientation_residual == b.orientation_residual
-            and all(np.array_equal(x.q, y.q) and x[1:] == y[1:]
+    # orientation residuals to 1e-15 rad: see ORIENTATION_ATOL in test_service_api.py
+    return (a.selected == b.selected
+            and abs(a.orientation_residual - b.orientation_residual) <= 1e-15
+            and all(np.array_equal(x.q, y.q) and x[1:4] == y[1:4]
+                    and abs(x.orientation_error - y.orientation_error) <= 1e-15
                     for x, y in zip(a.solutions, b.solutions, strict=True)))
 
 
