@@ -65,11 +65,13 @@ def _same(a: object, b: object) -> bool:
     from lynxplan.arm.model import IkResult
 
     assert isinstance(a, IkResult) and isinstance(b, IkResult)
-    # orientation residuals to 1e-15 rad: see ORIENTATION_ATOL in test_service_api.py
+    # floats to 1e-14: see KERNEL_ATOL in test_service_api.py (JIT vs cached numba kernels)
+    close = 1e-14
     return (a.selected == b.selected
-            and abs(a.orientation_residual - b.orientation_residual) <= 1e-15
-            and all(np.array_equal(x.q, y.q) and x[1:4] == y[1:4]
-                    and abs(x.orientation_error - y.orientation_error) <= 1e-15
+            and abs(a.orientation_residual - b.orientation_residual) <= close
+            and all(np.allclose(x.q, y.q, rtol=0, atol=close) and x[1:3] == y[1:3]
+                    and abs(x.position_error - y.position_error) <= close
+                    and abs(x.orientation_error - y.orientation_error) <= close
                     for x, y in zip(a.solutions, b.solutions, strict=True)))
 
 
