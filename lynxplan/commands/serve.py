@@ -43,6 +43,7 @@ def handle(args: argparse.Namespace) -> int:
         )
     if args.workers < 1 or not 0 < args.port < 65536:
         raise InputError("--workers must be >= 1 and --port within 1..65535")
+    _check_data_dir(Path(args.data_dir))
     config = ServiceConfig(
         data_dir=Path(args.data_dir), workers=args.workers, token=token,
         max_body=int(args.max_body * 1024**2), max_batch=args.max_batch,
@@ -58,6 +59,17 @@ def handle(args: argparse.Namespace) -> int:
         server_header=False,
     )
     return 0
+
+
+def _check_data_dir(folder: Path) -> None:
+    """A data dir that can hold the job store (one-line error before the server starts)."""
+    import sqlite3
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        sqlite3.connect(str(folder / "lynxplan.sqlite3")).close()
+    except (OSError, sqlite3.Error) as exc:
+        raise InputError(f"cannot use --data-dir {folder}: {exc}") from exc
 
 
 def _read_token(path: str | None) -> str | None:

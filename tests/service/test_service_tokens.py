@@ -33,6 +33,16 @@ def test_non_loopback_bind_without_token_refuses_to_start() -> None:
     assert done.stderr.count("\n") == 1 and "requires --token-file" in done.stderr
 
 
+def test_unusable_data_dir_is_a_one_line_error(tmp_path) -> None:
+    (tmp_path / "file").write_text("")
+    done = subprocess.run(
+        [sys.executable, "-m", "lynxplan.cli", "serve", "--data-dir", str(tmp_path / "file")],
+        capture_output=True, text=True, timeout=60, cwd=REPO,
+    )  # fmt: skip
+    assert done.returncode == 2 and done.stderr.count("\n") == 1
+    assert "cannot use --data-dir" in done.stderr
+
+
 def test_short_token_file_is_refused(tmp_path) -> None:
     (tmp_path / "t").write_text("short")
     done = subprocess.run(
