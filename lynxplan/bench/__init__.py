@@ -21,6 +21,7 @@ SECTIONS: dict[str, str] = {
     "task": "lynxplan.bench.task",
     "cold": "lynxplan.bench.cold",
     "plan": "lynxplan.bench.plan",
+    "serve": "lynxplan.bench.serve",
 }
 
 
