@@ -104,7 +104,7 @@ class GoalEntry(StrictModel):
 class PlannerEntry(StrictModel):
     """Planner options (see :class:`lynxplan.planning.PlannerOptions`)."""
 
-    seed: int = Field(0, ge=0, description="Random seed.")
+    seed: int = Field(0, ge=0, lt=2**63, description="Random seed, 0 <= seed < 2**63.")
     time_limit: Positive = Field(1.0, le=3600, description="Planning time budget, in [s].")
     clearance: Annotated[float, Field(ge=0, allow_inf_nan=False)] | None = Field(
         None, description="Required clearance, file's length unit (default 2 mm)."
@@ -364,11 +364,11 @@ def limit_violations(trajectory: Any, planner: Any) -> list[str]:
     )
     for what, values, bound in checks:
         over = values > bound
-        for j in np.flatnonzero(over.any(axis=0)).tolist():
-            found.append(
-                f"{space.joint_names[j]} {what} limit at t = "
-                f"{trajectory.t[int(np.argmax(over[:, j]))]:.3f} s"
-            )
+        found.extend(
+            f"{space.joint_names[j]} {what} limit at t = "
+            f"{trajectory.t[int(np.argmax(over[:, j]))]:.3f} s"
+            for j in np.flatnonzero(over.any(axis=0)).tolist()
+        )
     return found
 
 
