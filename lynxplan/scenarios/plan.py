@@ -354,7 +354,7 @@ def limit_violations(trajectory: Any, planner: Any) -> list[str]:
     from lynxplan.constants import LIMIT_CHECK_RELATIVE_TOLERANCE, LIMIT_SNAP_TOLERANCE
 
     slack = 1.0 + LIMIT_CHECK_RELATIVE_TOLERANCE
-    found = []
+    found: list[str] = []
     space = planner.space
     checks = (
         ("position below", -trajectory.q, -space.lower + LIMIT_SNAP_TOLERANCE),

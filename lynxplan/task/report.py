@@ -234,7 +234,8 @@ def task_details(scenario: Scenario, result: TaskResult) -> dict[str, Any]:
         "timing_comparison": _comparison(result),
         "stage_seconds": result.stage_seconds,
     }
-    return _clean(data)
+    cleaned: dict[str, Any] = _clean(data)
+    return cleaned
 
 
 def _clean(value: Any) -> Any:

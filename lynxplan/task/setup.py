@@ -15,6 +15,7 @@ import numpy as np
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import LynxplanError, ScenarioValueError
 from lynxplan.units import angle_factor, length_factor
+from lynxplan.viz import WritingPlane
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm
@@ -29,27 +30,6 @@ if TYPE_CHECKING:
     )
     from lynxplan.trajectory.limits import MotionLimits
     from lynxplan.trajectory.plan import Plan
-
-
-@dataclass(frozen=True)
-class WritingPlane:
-    """The writing surface (drawn only).
-
-    Attributes:
-        point: A point of the plane, shape (3,), in [m].
-        tilt: Angle to the x-y plane, rising along +y, in [rad].
-        size: Extent along x and along the rising direction, shape (2,), in [m].
-    """
-
-    point: np.ndarray
-    tilt: float
-    size: np.ndarray
-
-    @property
-    def rotation(self) -> np.ndarray:
-        """Plane axes (columns: x, rising direction, normal), shape (3, 3)."""
-        c, s = np.cos(self.tilt), np.sin(self.tilt)
-        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 @dataclass(frozen=True)
@@ -122,8 +102,10 @@ def _resolve(scenario: Scenario) -> TaskSetup:
     plane = None
     if scenario.writing_plane is not None:
         wp = scenario.writing_plane
-        plane = WritingPlane(
-            np.array(wp.point) * length, float(wp.tilt) * angle, np.array(wp.size) * length
+        plane = WritingPlane.tilted(
+            np.array(wp.point) * length,
+            float(wp.tilt) * angle,
+            (wp.size[0] * length, wp.size[1] * length),
         )
     return TaskSetup(arm, obstacles, waypoints, path, limits, Plan(tuple(segments), limits), plane)
 
@@ -170,7 +152,8 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
     ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
     rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
-    return rz @ ry @ rx
+    rotation: np.ndarray = rz @ ry @ rx
+    return rotation
 
 
 def _rotation(entry: BoxEntry | CylinderEntry, angle: float) -> np.ndarray | None:

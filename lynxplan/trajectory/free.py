@@ -30,7 +30,7 @@ def as_configuration(q: np.ndarray | list[float], name: str) -> np.ndarray:
     array = guards.float_array(name, q)
     if array.shape != (5,):
         raise ShapeError(name, "(5,)", array.shape)
-    out = as_configurations(guards.angles(name, array), name)[0].copy()
+    out: np.ndarray = as_configurations(guards.angles(name, array), name)[0].copy()
     out.setflags(write=False)
     return out
 
