@@ -84,7 +84,9 @@ def _data_path(data: Any, loc: tuple[Any, ...], missing: bool) -> tuple[int | st
     path: list[int | str] = []
     node = data
     for i, part in enumerate(loc):
-        if (isinstance(node, dict) and part in node) or (isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node)):
+        if (isinstance(node, dict) and part in node) or (
+            isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node)
+        ):
             node = node[part]
             path.append(part)
         elif missing and i == len(loc) - 1:
