@@ -67,12 +67,17 @@ def _same(a: object, b: object) -> bool:
     assert isinstance(a, IkResult) and isinstance(b, IkResult)
     # floats to 1e-14: see KERNEL_ATOL in test_service_api.py (JIT vs cached numba kernels)
     close = 1e-14
-    return (a.selected == b.selected
-            and abs(a.orientation_residual - b.orientation_residual) <= close
-            and all(np.allclose(x.q, y.q, rtol=0, atol=close) and x[1:3] == y[1:3]
-                    and abs(x.position_error - y.position_error) <= close
-                    and abs(x.orientation_error - y.orientation_error) <= close
-                    for x, y in zip(a.solutions, b.solutions, strict=True)))
+    return (
+        a.selected == b.selected
+        and abs(a.orientation_residual - b.orientation_residual) <= close
+        and all(
+            np.allclose(x.q, y.q, rtol=0, atol=close)
+            and x[1:3] == y[1:3]
+            and abs(x.position_error - y.position_error) <= close
+            and abs(x.orientation_error - y.orientation_error) <= close
+            for x, y in zip(a.solutions, b.solutions, strict=True)
+        )
+    )
 
 
 def test_32_clients_mixing_ik_and_runs(server: Server) -> None:

@@ -25,8 +25,9 @@ def test_runs_and_large_batches_go_to_dask(cluster, tmp_path) -> None:
     server = Server(tmp_path / "data", "--dask-scheduler", cluster.scheduler_address)
     try:
         with Client(server.url) as client, distributed.Client(cluster) as dask:
-            result = client.run(SCENARIOS / "free_motion.yaml", quick=True,
-                                out_dir=tmp_path / "out")
+            result = client.run(
+                SCENARIOS / "free_motion.yaml", quick=True, out_dir=tmp_path / "out"
+            )
             assert result.state == "succeeded" and result.ok
             assert (tmp_path / "out" / "trajectory.csv").stat().st_size > 0
             arm = load_arm()

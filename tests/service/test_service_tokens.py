@@ -55,8 +55,13 @@ def test_short_token_file_is_refused(tmp_path) -> None:
 @pytest.mark.parametrize("header", [None, "Bearer wrong", f"Bearer {TOKEN}x", TOKEN, "Basic abc"])
 def test_missing_or_wrong_token_is_401(guarded: Server, header: str | None) -> None:
     headers = {} if header is None else {"Authorization": header}
-    for method, path in (("GET", "/robots"), ("POST", "/ik"), ("GET", "/runs"),
-                         ("GET", "/openapi.json"), ("GET", "/no-such-route")):
+    for method, path in (
+        ("GET", "/robots"),
+        ("POST", "/ik"),
+        ("GET", "/runs"),
+        ("GET", "/openapi.json"),
+        ("GET", "/no-such-route"),
+    ):
         response = httpx.request(method, guarded.url + path, headers=headers)
         assert response.status_code == 401, (path, response.text)
         assert response.headers["content-type"].startswith("application/problem+json")
