@@ -14,14 +14,20 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm
+    from lynxplan.robots import Robot, load_robot
 
-__all__ = ["Arm", "LynxplanError", "__version__", "load_arm"]
+__all__ = ["Arm", "LynxplanError", "Robot", "__version__", "load_arm", "load_robot"]
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy attributes: ``lynxplan.load_arm`` and ``lynxplan.Arm``."""
+    """Lazy attributes: ``lynxplan.load_arm``, ``lynxplan.Arm``, ``lynxplan.load_robot``,
+    ``lynxplan.Robot``."""
     if name in ("load_arm", "Arm"):
         from lynxplan.arm import model
 
         return getattr(model, name)
+    if name in ("load_robot", "Robot"):
+        from lynxplan import robots
+
+        return getattr(robots, name)
     raise AttributeError(f"module 'lynxplan' has no attribute {name!r}")

@@ -1,0 +1,628 @@
+"""Numba kernels: every IK branch of a yaw-pitch-pitch-pitch-roll arm (see ``family.py``).
+
+For a fixed roll angle the tool point is fixed in the wrist link, and the problem is closed-form:
+the yaw angle from the lateral offset (two sides: front and back), the pitch sum from the
+approach direction projected into the arm plane (or from a given pitch), the shoulder and elbow
+from a two-link triangle (elbow up and down). When the tool point is on the roll axis the roll
+does not move it, so the roll is taken from the target (best roll about the approach axis) or
+given. When the tool point is off the roll axis and the roll is not given, the roll is the root
+of one scalar function on the roll joint's range (the approach must lie in the arm plane, or the
+roll must equal the best roll of the target): every root is bracketed on a uniform grid of
+:data:`ROOT_GRID` cells and refined by the Illinois method. Without a root, the roll that comes
+nearest is used and the residual reported.
+
+When the model is only close to the family (URDF angles written to 5 digits), each closed-form
+answer is polished by Newton's method on the exact chain, on the same five conditions.
+Angles are in [rad], lengths in [m].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.chain import chain_fk
+
+MODE_POSE, MODE_APPROACH, MODE_PITCH = 0, 1, 2
+#: Uniform cells over the roll range on which the roots of the roll equation are bracketed.
+ROOT_GRID = 48
+#: At most this many roll roots per side are kept (each gives two elbow branches).
+MAX_ROOTS = 4
+TWO_PI = 2.0 * math.pi
+_NEWTON_STEPS = 40
+_NEWTON_TOLERANCE = 1e-14
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _rotate(
+    u0: float, u1: float, u2: float, c: float, s: float, v0: float, v1: float, v2: float
+) -> tuple[float, float, float]:
+    """Rodrigues: v rotated by the angle with cosine c and sine s about the unit axis u."""
+    d = (u0 * v0 + u1 * v1 + u2 * v2) * (1.0 - c)
+    return (
+        v0 * c + (u1 * v2 - u2 * v1) * s + u0 * d,
+        v1 * c + (u2 * v0 - u0 * v2) * s + u1 * d,
+        v2 * c + (u0 * v1 - u1 * v0) * s + u2 * d,
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _wrap(x: float) -> float:
+    return x - TWO_PI * math.floor((x + math.pi) / TWO_PI)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
+    """x moved by whole turns into [lo, hi] (snapped within tol), or the nearest copy outside."""
+    if lo <= x <= hi:
+        return x, True
+    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI
+    if y <= hi:
+        return y, True
+    if y <= hi + tol:
+        return hi, True
+    if y >= lo + TWO_PI - tol:
+        return lo, True
+    return (y, False) if y - hi <= lo + TWO_PI - y else (y - TWO_PI, False)
+
+
+@numba.njit(cache=True, nogil=True)
+def _yaw(
+    prm: np.ndarray, d0: float, d1: float, d2: float, theta: float, side: int, phi_ref: float
+) -> tuple[float, float]:
+    """Canonical yaw angle phi of one side for roll theta, and the lateral miss [m]."""
+    dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
+    dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
+    lat = (
+        prm[F.LAM4]
+        + prm[F.W0 + 2]
+        + math.cos(theta) * prm[F.E1 + 2]
+        + math.sin(theta) * prm[F.E2 + 2]
+    )
+    rho = math.hypot(dp, dh)
+    if rho <= 1e-12 and abs(lat) <= 1e-12:  # on the yaw axis: any yaw; keep the reference
+        return phi_ref + side * math.pi, 0.0
+    ratio, miss = lat / rho if rho > 0 else math.copysign(1.0, lat), 0.0
+    if ratio > 1.0:
+        miss, ratio = lat - rho, 1.0
+    elif ratio < -1.0:
+        miss, ratio = -lat - rho, -1.0
+    beta = math.acos(ratio)
+    alpha = math.atan2(dh, dp)
+    return (alpha - beta if side == 0 else alpha + beta), miss
+
+
+@numba.njit(cache=True, nogil=True)
+def _plane_target(
+    prm: np.ndarray, d0: float, d1: float, d2: float, phi: float
+) -> tuple[float, float]:
+    """Target point in the arm plane (outward, up) for yaw phi."""
+    c, s = math.cos(phi), math.sin(phi)
+    dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
+    dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
+    dk = d0 * prm[F.K] + d1 * prm[F.K + 1] + d2 * prm[F.K + 2]
+    return c * dh - s * dp, dk
+
+
+@numba.njit(cache=True, nogil=True)
+def _approach_in_plane(
+    prm: np.ndarray, a0: float, a1: float, a2: float, phi: float
+) -> tuple[float, float, float]:
+    """Components of the approach a along h(phi), k and p(phi)."""
+    c, s = math.cos(phi), math.sin(phi)
+    ap = a0 * prm[F.P] + a1 * prm[F.P + 1] + a2 * prm[F.P + 2]
+    ah = a0 * prm[F.H] + a1 * prm[F.H + 1] + a2 * prm[F.H + 2]
+    ak = a0 * prm[F.K] + a1 * prm[F.K + 1] + a2 * prm[F.K + 2]
+    return c * ah - s * ap, ak, c * ap + s * ah
+
+
+@numba.njit(cache=True, nogil=True)
+def _best_roll(prm: np.ndarray, g: np.ndarray, phi: float, pitch_sum: float) -> float:
+    """Canonical roll theta nearest the target: argmax tr(R(r, theta)^T M), M = Q^T G."""
+    k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
+    p0, p1, p2 = prm[F.P], prm[F.P + 1], prm[F.P + 2]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    cy, sy = math.cos(-phi), math.sin(-phi)
+    cp, sp = math.cos(-pitch_sum), math.sin(-pitch_sum)
+    m = np.empty((3, 3))
+    for j in range(3):
+        v0, v1, v2 = _rotate(k0, k1, k2, cy, sy, g[0, j], g[1, j], g[2, j])
+        v0, v1, v2 = _rotate(p0, p1, p2, cp, sp, v0, v1, v2)
+        m[0, j], m[1, j], m[2, j] = v0, v1, v2
+    sine = r0 * (m[2, 1] - m[1, 2]) + r1 * (m[0, 2] - m[2, 0]) + r2 * (m[1, 0] - m[0, 1])
+    rmr = 0.0
+    for i in range(3):
+        rmr += prm[F.R + i] * (m[i, 0] * r0 + m[i, 1] * r1 + m[i, 2] * r2)
+    return math.atan2(sine, m[0, 0] + m[1, 1] + m[2, 2] - rmr)
+
+
+@numba.njit(cache=True, nogil=True)
+def _pitch_sum(
+    prm: np.ndarray,
+    mode: int,
+    a0: float,
+    a1: float,
+    a2: float,
+    pitch: float,
+    phi: float,
+    ref_sum: float,
+) -> tuple[float, float]:
+    """Canonical pitch sum Phi for yaw phi, and the out-of-plane approach component."""
+    if mode == MODE_PITCH:
+        return pitch - 0.5 * math.pi - prm[F.GAMMA0], 0.0
+    ah, ak, out = _approach_in_plane(prm, a0, a1, a2, phi)
+    if math.hypot(ah, ak) <= 1e-12:  # approach along the pitch axis: any pitch is as good
+        return ref_sum, out
+    return math.atan2(ak, ah) - prm[F.GAMMA0], out
+
+
+@numba.njit(cache=True, nogil=True)
+def _roll_equation(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    theta: float,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+) -> float:
+    # g[:, 3] holds the target approach axis (column 3 of the (3, 4) scratch)
+    """The scalar whose roots are the rolls of an off-axis tool (one side)."""
+    d0, d1, d2 = (
+        target[0, 3] - prm[F.C1],
+        target[1, 3] - prm[F.C1 + 1],
+        target[2, 3] - prm[F.C1 + 2],
+    )
+    phi, _ = _yaw(prm, d0, d1, d2, theta, side, phi_ref)
+    big_phi, out = _pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
+    if mode == MODE_APPROACH:
+        return out
+    return _wrap(_best_roll(prm, g, phi, big_phi) - theta)
+
+
+@numba.njit(cache=True, nogil=True)
+def _refine_root(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+    a: float,
+    fa: float,
+    b: float,
+    fb: float,
+) -> float:
+    """Illinois regula falsi on a bracket [a, b] with fa * fb < 0."""
+    side_kept = 0
+    for _ in range(80):
+        c = (a * fb - b * fa) / (fb - fa)
+        if not (min(a, b) <= c <= max(a, b)):
+            c = 0.5 * (a + b)
+        fc = _roll_equation(prm, target, g, mode, c, side, phi_ref, sum_ref)
+        if fc == 0.0 or abs(b - a) < 1e-15:
+            return c
+        if (fc > 0) == (fb > 0):
+            b, fb = c, fc
+            if side_kept == -1:
+                fa *= 0.5
+            side_kept = -1
+        else:
+            a, fa = c, fc
+            if side_kept == 1:
+                fb *= 0.5
+            side_kept = 1
+        if abs(b - a) < 4e-16 * (1.0 + abs(c)):
+            return c
+    return (a * fb - b * fa) / (fb - fa)
+
+
+@numba.njit(cache=True, nogil=True)
+def _roll_candidates(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+    lo: float,
+    hi: float,
+    roots: np.ndarray,
+) -> int:
+    """Every root of the roll equation in [lo, hi] (at most MAX_ROOTS), else the minimiser of
+    its magnitude; returns the count written into ``roots``."""
+    step = (hi - lo) / ROOT_GRID
+    count = 0
+    x0 = lo
+    f0 = _roll_equation(prm, target, g, mode, x0, side, phi_ref, sum_ref)
+    best_x, best_f = x0, abs(f0)
+    for i in range(1, ROOT_GRID + 1):
+        x1 = lo + i * step if i < ROOT_GRID else hi
+        f1 = _roll_equation(prm, target, g, mode, x1, side, phi_ref, sum_ref)
+        if abs(f1) < best_f:
+            best_x, best_f = x1, abs(f1)
+        if f0 == 0.0:
+            if count < MAX_ROOTS and (count == 0 or roots[count - 1] != x0):
+                roots[count] = x0
+                count += 1
+        elif (f0 < 0.0) != (f1 < 0.0) and f1 != 0.0:
+            # a wrap of the best-roll difference through +-pi is a jump, not a root
+            if mode == MODE_APPROACH or (abs(f0) < 0.5 * math.pi and abs(f1) < 0.5 * math.pi):
+                if count < MAX_ROOTS:
+                    roots[count] = _refine_root(
+                        prm, target, g, mode, side, phi_ref, sum_ref, x0, f0, x1, f1
+                    )
+                    count += 1
+        x0, f0 = x1, f1
+    if f0 == 0.0 and count < MAX_ROOTS and (count == 0 or roots[count - 1] != x0):
+        roots[count] = x0
+        count += 1
+    if count > 0:
+        return count
+    # no root: golden-section search of |f| around the best grid point
+    a, b = max(lo, best_x - step), min(hi, best_x + step)
+    inv = 0.5 * (math.sqrt(5.0) - 1.0)
+    for _ in range(60):
+        c, d = b - inv * (b - a), a + inv * (b - a)
+        fc = abs(_roll_equation(prm, target, g, mode, c, side, phi_ref, sum_ref))
+        fd = abs(_roll_equation(prm, target, g, mode, d, side, phi_ref, sum_ref))
+        if fc < fd:
+            b = d
+        else:
+            a = c
+    x = 0.5 * (a + b)
+    roots[0] = (
+        x
+        if abs(_roll_equation(prm, target, g, mode, x, side, phi_ref, sum_ref)) < best_f
+        else best_x
+    )
+    return 1
+
+
+@numba.njit(cache=True, nogil=True)
+def _two_link(prm: np.ndarray, x: float, y: float, elbow: int) -> tuple[float, float, float]:
+    """Canonical shoulder and elbow angles reaching the wrist point (x, y); and the miss [m]."""
+    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
+    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
+    la, lb = math.hypot(l20, l21), math.hypot(l30, l31)
+    b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
+    rx, ry = x - prm[F.O2], y - prm[F.O2 + 1]
+    dist = math.hypot(rx, ry)
+    cosd = (dist * dist - la * la - lb * lb) / (2.0 * la * lb)
+    miss = 0.0
+    if cosd > 1.0:
+        miss, cosd = dist - (la + lb), 1.0
+    elif cosd < -1.0:
+        miss, cosd = abs(la - lb) - dist, -1.0
+    delta = math.acos(cosd)
+    if prm[F.EXACT] == 0.0 and abs(cosd) > 1.0 - 1e-6:
+        # near a fold of a model that is only close to the family: start the two elbows apart,
+        # Newton then finds each exact root (they are ~sqrt(deviation) apart)
+        delta = max(delta, 2e-3) if cosd > 0 else min(delta, math.pi - 2e-3)
+    if elbow == 0:  # elbow up: the elbow lies above the shoulder-wrist line
+        delta = -delta
+    t2 = math.atan2(ry, rx) - math.atan2(lb * math.sin(delta), la + lb * math.cos(delta))
+    psi2 = t2 - b2
+    psi3 = delta + b2 - b3
+    return psi2, psi3, miss
+
+
+@numba.njit(cache=True, nogil=True)
+def _branch(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    theta: float,
+    side: int,
+    elbow: int,
+    phi_ref: float,
+    sum_ref: float,
+    out: np.ndarray,
+) -> float:
+    """Joint angles of one branch for roll theta into out (5,); returns the reach miss [m]."""
+    d0, d1, d2 = (
+        target[0, 3] - prm[F.C1],
+        target[1, 3] - prm[F.C1 + 1],
+        target[2, 3] - prm[F.C1 + 2],
+    )
+    phi, lat_miss = _yaw(prm, d0, d1, d2, theta, side, phi_ref)
+    big_phi, _ = _pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], pitch, phi, sum_ref)
+    if mode == MODE_POSE and prm[F.OFF_AXIS] == 0.0:
+        theta = _best_roll(prm, g, phi, big_phi)
+    x, y = _plane_target(prm, d0, d1, d2, phi)
+    ct, st = math.cos(theta), math.sin(theta)
+    wh = prm[F.W0] + ct * prm[F.E1] + st * prm[F.E2]
+    wk = prm[F.W0 + 1] + ct * prm[F.E1 + 1] + st * prm[F.E2 + 1]
+    cp, sp = math.cos(big_phi), math.sin(big_phi)
+    psi2, psi3, miss = _two_link(prm, x - (cp * wh - sp * wk), y - (sp * wh + cp * wk), elbow)
+    out[0] = prm[F.SIGMA] * phi
+    out[1] = prm[F.SIGMA + 1] * psi2
+    out[2] = prm[F.SIGMA + 2] * psi3
+    out[3] = prm[F.SIGMA + 3] * (big_phi - psi2 - psi3)
+    out[4] = prm[F.SIGMA + 4] * theta
+    return math.hypot(miss, lat_miss)
+
+
+@numba.njit(cache=True, nogil=True)
+def _conditions(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    roll_given: float,
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+    e: np.ndarray,
+) -> None:
+    """The five conditions the branch satisfies, evaluated on the exact chain."""
+    chain_fk(placements, axes, q, pose, work)
+    for i in range(3):
+        e[i] = pose[i, 3] - target[i, 3]
+    # approach axis and pitch axis of the reached configuration
+    a = np.empty(3)
+    at = np.empty(3)
+    rt = prm[F.RT0 : F.RT0 + 9]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    # approach in the tool frame: Rt0^T r
+    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
+    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
+    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
+    for i in range(3):
+        a[i] = pose[i, 0] * u0 + pose[i, 1] * u1 + pose[i, 2] * u2
+    cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
+    k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
+    pp0, pp1, pp2 = _rotate(k0, k1, k2, cy, sy, prm[F.P], prm[F.P + 1], prm[F.P + 2])
+    if mode == MODE_PITCH:
+        h0, h1, h2 = _rotate(k0, k1, k2, cy, sy, prm[F.H], prm[F.H + 1], prm[F.H + 2])
+        sp, cp = math.sin(pitch), math.cos(pitch)
+        at[0], at[1], at[2] = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
+    else:
+        at[0], at[1], at[2] = g[0, 3], g[1, 3], g[2, 3]
+    # in-plane approach angle matches: (a x at) . p = 0
+    c0 = a[1] * at[2] - a[2] * at[1]
+    c1 = a[2] * at[0] - a[0] * at[2]
+    c2 = a[0] * at[1] - a[1] * at[0]
+    e[3] = c0 * pp0 + c1 * pp1 + c2 * pp2
+    if (
+        not math.isnan(roll_given)
+        or mode == MODE_PITCH
+        or (mode == MODE_APPROACH and prm[F.OFF_AXIS] == 0.0)
+    ):
+        e[4] = q[4] - roll_given
+    elif mode == MODE_APPROACH:
+        e[4] = at[0] * pp0 + at[1] * pp1 + at[2] * pp2
+    else:  # best roll about the approach axis: a . vee(Rt R^T - R Rt^T) = 0
+        v = 0.0
+        for i in range(3):
+            j, l = (i + 1) % 3, (i + 2) % 3
+            s = 0.0
+            for m in range(3):
+                s += target[l, m] * pose[j, m] - pose[l, m] * target[j, m]
+            v += a[i] * s
+        e[4] = v
+
+
+@numba.njit(cache=True, nogil=True)
+def _polish(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    roll_given: float,
+    q: np.ndarray,
+) -> None:
+    """Newton's method on the five conditions, on the exact chain (finite-difference Jacobian).
+
+    Keeps the closed-form answer when Newton does not reduce the conditions (unreachable).
+    """
+    pose, work = np.empty((4, 4)), np.empty((4, 4))
+    e, e2 = np.empty(5), np.empty(5)
+    jac = np.empty((5, 5))
+    qh = np.empty(5)
+    start = q.copy()
+    first = np.inf
+    norm = np.inf
+    for it in range(_NEWTON_STEPS + 1):
+        _conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
+        norm = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
+        if it == 0:
+            first = norm
+        if norm < _NEWTON_TOLERANCE or it == _NEWTON_STEPS or not math.isfinite(norm):
+            break
+        for j in range(5):
+            qh[:] = q
+            qh[j] += 1e-7
+            _conditions(
+                prm, placements, axes, target, g, mode, pitch, roll_given, qh, pose, work, e2
+            )
+            for i in range(5):
+                jac[i, j] = (e2[i] - e[i]) / 1e-7
+        if abs(np.linalg.det(jac)) < 1e-300:
+            break
+        step = np.linalg.solve(jac, e)
+        for j in range(5):
+            q[j] -= step[j]
+    if not (norm <= first):
+        q[:] = start
+
+
+@numba.njit(cache=True, nogil=True)
+def _orientation_error(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    q: np.ndarray,
+    pose: np.ndarray,
+) -> float:
+    """Angle between target and reached orientation (pose) or approach axes (approach, pitch)."""
+    if mode == MODE_POSE:
+        s0 = s1 = s2 = 0.0
+        tr = 0.0
+        for i in range(3):
+            tr += target[0, i] * pose[0, i] + target[1, i] * pose[1, i] + target[2, i] * pose[2, i]
+        # vee of (Rt^T R - R^T Rt): rows of Rt^T R are columns of Rt dotted with columns of R
+        m01 = m10 = m02 = m20 = m12 = m21 = 0.0
+        for r in range(3):
+            m01 += target[r, 0] * pose[r, 1]
+            m10 += target[r, 1] * pose[r, 0]
+            m02 += target[r, 0] * pose[r, 2]
+            m20 += target[r, 2] * pose[r, 0]
+            m12 += target[r, 1] * pose[r, 2]
+            m21 += target[r, 2] * pose[r, 1]
+        s0, s1, s2 = m21 - m12, m02 - m20, m10 - m01
+        return math.atan2(0.5 * math.sqrt(s0 * s0 + s1 * s1 + s2 * s2), 0.5 * (tr - 1.0))
+    rt = prm[F.RT0 : F.RT0 + 9]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
+    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
+    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
+    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
+    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
+    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+    if mode == MODE_PITCH:
+        k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
+        cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
+        h0, h1, h2 = _rotate(k0, k1, k2, cy, sy, prm[F.H], prm[F.H + 1], prm[F.H + 2])
+        sp, cp = math.sin(pitch), math.cos(pitch)
+        t0, t1, t2 = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
+    else:
+        t0, t1, t2 = g[0, 3], g[1, 3], g[2, 3]
+    c0, c1, c2 = a1 * t2 - a2 * t1, a2 * t0 - a0 * t2, a0 * t1 - a1 * t0
+    return math.atan2(math.sqrt(c0 * c0 + c1 * c1 + c2 * c2), a0 * t0 + a1 * t1 + a2 * t2)
+
+
+@numba.njit(cache=True, nogil=True)
+def family_ik_kernel(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    targets: np.ndarray,
+    mode: int,
+    pitch: np.ndarray,
+    roll: np.ndarray,
+    reference: np.ndarray,
+    q_out: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+    miss_out: np.ndarray,
+) -> None:
+    """Every branch of N targets.
+
+    Args:
+        prm: Packed family parameters (``family.py``).
+        placements, axes: The exact chain (``chain.py``).
+        targets: (N, 4, 4) poses; for approach targets only column 2 (approach) and 3 count.
+        mode: MODE_POSE, MODE_APPROACH or MODE_PITCH.
+        pitch: (N,) approach pitch for MODE_PITCH [rad] (from straight down towards outward).
+        roll: (N,) roll joint angle [rad], NaN where free.
+        reference: (N, 5) or (1, 5) joint angles [rad]: yaw on the base axis, the pitch sum when
+            the approach is along the pitch axis, the roll where free and not determined.
+        q_out: (N, B, 5) output angles; B = 4 (closed form) or 4 * MAX_ROOTS (root search).
+        valid, within: (N, B) output flags (branch exists; within joint limits).
+        position_error, orientation_error: (N, B) output, [m] and [rad] on the exact chain.
+        miss_out: (N, B) output: by how much the closed form missed the reach, [m].
+    """
+    nb = q_out.shape[1]
+    per_side = nb // 2
+    lower, upper = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5]
+    tol = prm[F.LIMIT_TOL]
+    sig5 = prm[F.SIGMA + 4]
+    lo5, hi5 = sig5 * lower[4], sig5 * upper[4]
+    if lo5 > hi5:
+        lo5, hi5 = hi5, lo5
+    if hi5 - lo5 > TWO_PI:
+        hi5 = lo5 + TWO_PI
+    rt0 = prm[F.RT0 : F.RT0 + 9]
+    g = np.empty((3, 4))  # G = Rt Rt0^T, then the target approach axis
+    pose, work = np.empty((4, 4)), np.empty((4, 4))
+    roots = np.empty(MAX_ROOTS)
+    q = np.empty(5)
+    exact = prm[F.EXACT] != 0.0
+    off_axis = prm[F.OFF_AXIS] != 0.0
+    for n in range(targets.shape[0]):
+        target = targets[n]
+        ref = reference[n if reference.shape[0] > 1 else 0]
+        phi_ref = prm[F.SIGMA] * ref[0]
+        sum_ref = prm[F.SIGMA + 1] * ref[1] + prm[F.SIGMA + 2] * ref[2] + prm[F.SIGMA + 3] * ref[3]
+        if mode == MODE_POSE:
+            for i in range(3):  # G = Rt Rt0^T
+                for j in range(3):
+                    g[i, j] = (
+                        target[i, 0] * rt0[3 * j]
+                        + target[i, 1] * rt0[3 * j + 1]
+                        + target[i, 2] * rt0[3 * j + 2]
+                    )
+        if mode == MODE_POSE:  # approach = Rt (Rt0^T r)
+            for i in range(3):
+                g[i, 3] = g[i, 0] * prm[F.R] + g[i, 1] * prm[F.R + 1] + g[i, 2] * prm[F.R + 2]
+        else:
+            for i in range(3):
+                g[i, 3] = target[i, 2]
+        roll_given = roll[n]
+        need_roots = off_axis and math.isnan(roll_given) and mode != MODE_PITCH
+        theta_fixed = sig5 * (ref[4] if math.isnan(roll_given) else roll_given)
+        for b in range(nb):
+            valid[n, b] = False
+            within[n, b] = False
+            position_error[n, b] = np.nan
+            orientation_error[n, b] = np.nan
+            miss_out[n, b] = np.nan
+            for j in range(5):
+                q_out[n, b, j] = np.nan
+        for side in range(2):
+            count = 1
+            roots[0] = theta_fixed
+            if need_roots:
+                count = _roll_candidates(
+                    prm, target, g, mode, side, phi_ref, sum_ref, lo5, hi5, roots
+                )
+            for ri in range(count):
+                for elbow in range(2):
+                    b = side * per_side + ri * 2 + elbow
+                    miss = _branch(
+                        prm, target, g, mode, pitch[n], roots[ri], side, elbow, phi_ref, sum_ref, q
+                    )
+                    if not exact:
+                        rg = roll_given
+                        if math.isnan(rg) and (
+                            mode == MODE_PITCH or (mode == MODE_APPROACH and not off_axis)
+                        ):
+                            rg = q[4]
+                        _polish(prm, placements, axes, target, g, mode, pitch[n], rg, q)
+                    inside = True
+                    for j in range(5):
+                        x, ok = _wrap_into_limits(q[j], lower[j], upper[j], tol)
+                        q_out[n, b, j] = x
+                        q[j] = x
+                        inside = inside and ok
+                    chain_fk(placements, axes, q, pose, work)
+                    err = 0.0
+                    for i in range(3):
+                        d = pose[i, 3] - target[i, 3]
+                        err += d * d
+                    valid[n, b] = True
+                    within[n, b] = inside
+                    position_error[n, b] = math.sqrt(err)
+                    orientation_error[n, b] = _orientation_error(
+                        prm, target, g, mode, pitch[n], q, pose
+                    )
+                    miss_out[n, b] = miss

@@ -1,0 +1,119 @@
+"""Python side of the yaw-pitch-pitch-pitch-roll solver: packing, AL5 delegation, results."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from lynxplan.robots.ik import family_kernel as fk_
+from lynxplan.robots.results import RobotIkBatch
+
+if TYPE_CHECKING:
+    from lynxplan.robots.robot import Robot, Target
+
+_SIDES = ("front", "back")
+_ELBOWS = ("elbow-up", "elbow-down")
+
+
+def branch_names(slots: int) -> tuple[str, ...]:
+    """Names of the branch slots: side/elbow (4 slots) or side/roll-i/elbow (root search)."""
+    if slots == 4:
+        return tuple(f"{s}/{e}" for s in _SIDES for e in _ELBOWS)
+    return tuple(
+        f"{s}/roll-{r + 1}/{e}" for s in _SIDES for r in range(fk_.MAX_ROOTS) for e in _ELBOWS
+    )
+
+
+def needs_root_search(robot: Robot, target: Target) -> bool:
+    """Whether the roll is found by root search (off-axis tool, roll not given, not pitch)."""
+    family = robot.family
+    assert family is not None
+    return (
+        not family.tool_on_roll_axis
+        and target.kind != fk_.MODE_PITCH
+        and bool(np.isnan(target.roll).any())
+    )
+
+
+def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIkBatch:
+    """Every branch of each target (see ``family_kernel``)."""
+    from lynxplan.robots.robot import REACH_TOLERANCE
+
+    family = robot.family
+    assert family is not None
+    n = target.poses.shape[0]
+    slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
+    q = np.empty((n, slots, 5))
+    valid = np.empty((n, slots), dtype=np.bool_)
+    within = np.empty((n, slots), dtype=np.bool_)
+    perr = np.empty((n, slots))
+    oerr = np.empty((n, slots))
+    miss = np.empty((n, slots))
+    fk_.family_ik_kernel(
+        family.packed,
+        robot.chain.placements,
+        robot.chain.axes,
+        target.poses,
+        target.kind,
+        target.pitch,
+        target.roll,
+        reference,
+        q,
+        valid,
+        within,
+        perr,
+        oerr,
+        miss,
+    )
+    if robot._arm is not None and target.kind != fk_.MODE_PITCH:
+        _al5_override(robot, target, reference, q, within, perr, oerr)
+    distance = np.where(valid, perr, np.inf).min(axis=1)
+    reachable = distance <= REACH_TOLERANCE
+    # a reachable target's solutions are the branches that reach it; the others are dropped
+    valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
+    for array in (q, valid, within, perr, oerr, reachable, distance):
+        array.setflags(write=False)
+    return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
+
+
+def _al5_override(
+    robot: Robot,
+    target: Target,
+    reference: np.ndarray,
+    q: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> None:
+    """Reachable AL5 targets: the branches of lynxplan.arm (same numbers as before)."""
+    from lynxplan.arm.ik import IkStatus
+
+    ref = np.broadcast_to(reference, (target.poses.shape[0], 5)).copy()
+    given = ~np.isnan(target.roll)
+    ref[given, 4] = target.roll[given]
+    arm = robot._arm
+    batch = arm.ik_batch(
+        target.poses, q_reference=ref, approach_only=target.kind == fk_.MODE_APPROACH
+    )
+    ok = np.asarray(batch.status) == IkStatus.OK
+    if not ok.any():
+        return
+    q_arm = np.asarray(batch.q)[ok]
+    poses = np.asarray(arm.fk(q_arm.reshape(-1, 5))).reshape(-1, 4, 4, 4)
+    goal = target.poses[ok]
+    q[ok] = q_arm
+    within[ok] = np.asarray(batch.within_limits)[ok]
+    perr[ok] = np.linalg.norm(poses[:, :, :3, 3] - goal[:, None, :3, 3], axis=2)
+    if target.kind == fk_.MODE_APPROACH:
+        cosine = np.einsum("nbi,ni->nb", poses[:, :, :3, 2], goal[:, :3, 2])
+        sine = np.linalg.norm(np.cross(poses[:, :, :3, 2], goal[:, None, :3, 2]), axis=2)
+        oerr[ok] = np.arctan2(sine, cosine)
+    else:
+        m = np.einsum("nji,nbjk->nbik", goal[:, :3, :3], poses[:, :, :3, :3])
+        trace = np.trace(m, axis1=2, axis2=3)
+        vee = np.stack(
+            (m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]),
+            axis=-1,
+        )
+        oerr[ok] = np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), 0.5 * (trace - 1.0))
