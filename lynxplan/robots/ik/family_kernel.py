@@ -223,66 +223,90 @@ def _refine_root(
 
 
 @numba.njit(cache=True, nogil=True)
-def _roll_candidates(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
-    lo: float,
-    hi: float,
-    roots: np.ndarray,
-) -> int:
-    """Every root of the roll equation in [lo, hi] (at most MAX_ROOTS), else the minimiser of
-    its magnitude; returns the count written into ``roots``."""
-    step = (hi - lo) / ROOT_GRID
-    count = 0
-    x0 = lo
-    f0 = _roll_equation(prm, target, g, mode, x0, side, phi_ref, sum_ref)
-    best_x, best_f = x0, abs(f0)
-    for i in range(1, ROOT_GRID + 1):
-        x1 = lo + i * step if i < ROOT_GRID else hi
-        f1 = _roll_equation(prm, target, g, mode, x1, side, phi_ref, sum_ref)
-        if abs(f1) < best_f:
-            best_x, best_f = x1, abs(f1)
-        if f0 == 0.0:
-            if count < MAX_ROOTS and (count == 0 or roots[count - 1] != x0):
-                roots[count] = x0
-                count += 1
-        elif (f0 < 0.0) != (f1 < 0.0) and f1 != 0.0:
-            # a wrap of the best-roll difference through +-pi is a jump, not a root
-            if mode == MODE_APPROACH or (abs(f0) < 0.5 * math.pi and abs(f1) < 0.5 * math.pi):
-                if count < MAX_ROOTS:
-                    roots[count] = _refine_root(
-                        prm, target, g, mode, side, phi_ref, sum_ref, x0, f0, x1, f1
-                    )
-                    count += 1
-        x0, f0 = x1, f1
-    if f0 == 0.0 and count < MAX_ROOTS and (count == 0 or roots[count - 1] != x0):
-        roots[count] = x0
-        count += 1
-    if count > 0:
-        return count
-    # no root: golden-section search of |f| around the best grid point
-    a, b = max(lo, best_x - step), min(hi, best_x + step)
+def _golden(
+    prm: np.ndarray, target: np.ndarray, g: np.ndarray, mode: int, side: int, phi_ref: float,
+    sum_ref: float, a: float, b: float, sign: float,
+) -> float:
+    """Minimiser of sign * f on [a, b] (golden-section search)."""
     inv = 0.5 * (math.sqrt(5.0) - 1.0)
     for _ in range(60):
         c, d = b - inv * (b - a), a + inv * (b - a)
-        fc = abs(_roll_equation(prm, target, g, mode, c, side, phi_ref, sum_ref))
-        fd = abs(_roll_equation(prm, target, g, mode, d, side, phi_ref, sum_ref))
+        fc = sign * _roll_equation(prm, target, g, mode, c, side, phi_ref, sum_ref)
+        fd = sign * _roll_equation(prm, target, g, mode, d, side, phi_ref, sum_ref)
         if fc < fd:
             b = d
         else:
             a = c
-    x = 0.5 * (a + b)
-    roots[0] = (
-        x
-        if abs(_roll_equation(prm, target, g, mode, x, side, phi_ref, sum_ref)) < best_f
-        else best_x
-    )
-    return 1
+        if b - a < 1e-15:
+            break
+    return 0.5 * (a + b)
+
+
+@numba.njit(cache=True, nogil=True)
+def _roll_candidates(
+    prm: np.ndarray, target: np.ndarray, g: np.ndarray, mode: int, side: int, phi_ref: float,
+    sum_ref: float, lo: float, hi: float, roots: np.ndarray,
+) -> int:
+    """Every root of the roll equation in [lo, hi] (at most MAX_ROOTS); returns their count.
+
+    Roots are bracketed by sign changes on the grid; a pair of roots inside one cell (a near
+    double root) shows as a local minimum of |f| without a sign change: the extremum is located
+    by golden section and both halves bracketed. Without any root, writes the minimiser of |f|
+    and returns -1.
+    """
+    xs = np.empty(ROOT_GRID + 1)
+    fs = np.empty(ROOT_GRID + 1)
+    for i in range(ROOT_GRID + 1):
+        xs[i] = lo + (hi - lo) * i / ROOT_GRID
+        fs[i] = _roll_equation(prm, target, g, mode, xs[i], side, phi_ref, sum_ref)
+    count = 0
+    best = 0
+    for i in range(ROOT_GRID + 1):
+        if abs(fs[i]) < abs(fs[best]):
+            best = i
+        if count >= MAX_ROOTS:
+            break
+        if fs[i] == 0.0:
+            roots[count] = xs[i]
+            count += 1
+            continue
+        if i == ROOT_GRID:
+            break
+        f0, f1 = fs[i], fs[i + 1]
+        jump = mode != MODE_APPROACH and (abs(f0) > 0.5 * math.pi or abs(f1) > 0.5 * math.pi)
+        if f1 != 0.0 and (f0 < 0.0) != (f1 < 0.0):
+            if not jump:  # a wrap of the best-roll difference through +-pi is not a root
+                roots[count] = _refine_root(
+                    prm, target, g, mode, side, phi_ref, sum_ref, xs[i], f0, xs[i + 1], f1
+                )
+                count += 1
+        elif 0 < i and (fs[i - 1] < 0.0) == (f0 < 0.0) and not jump:
+            # local extremum of |f| at grid point i: two roots may hide in [x_{i-1}, x_{i+1}]
+            if abs(f0) < abs(fs[i - 1]) and abs(f0) <= abs(f1):
+                sign = 1.0 if f0 > 0 else -1.0
+                xm = _golden(
+                    prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], xs[i + 1], sign
+                )
+                fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
+                if fm == 0.0:
+                    roots[count] = xm
+                    count += 1
+                elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
+                    roots[count] = _refine_root(
+                        prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], fs[i - 1], xm, fm
+                    )
+                    roots[count + 1] = _refine_root(
+                        prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[i + 1], f1
+                    )
+                    count += 2
+    if count > 0:
+        return count
+    a, b = xs[max(best - 1, 0)], xs[min(best + 1, ROOT_GRID)]
+    sign = 1.0 if fs[best] > 0 else -1.0
+    xm = _golden(prm, target, g, mode, side, phi_ref, sum_ref, a, b, sign)
+    fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
+    roots[0] = xm if abs(fm) < abs(fs[best]) else xs[best]
+    return -1
 
 
 @numba.njit(cache=True, nogil=True)
@@ -401,8 +425,11 @@ def _conditions(
         or (mode == MODE_APPROACH and prm[F.OFF_AXIS] == 0.0)
     ):
         e[4] = q[4] - roll_given
-    elif mode == MODE_APPROACH:
-        e[4] = at[0] * pp0 + at[1] * pp1 + at[2] * pp2
+    elif mode == MODE_APPROACH:  # the approach exactly: (a x at) . (a x p) = 0 as well
+        w0 = a[1] * pp2 - a[2] * pp1
+        w1 = a[2] * pp0 - a[0] * pp2
+        w2 = a[0] * pp1 - a[1] * pp0
+        e[4] = c0 * w0 + c1 * w1 + c2 * w2
     else:  # best roll about the approach axis: a . vee(Rt R^T - R Rt^T) = 0
         v = 0.0
         for i in range(3):
@@ -425,7 +452,7 @@ def _polish(
     pitch: float,
     roll_given: float,
     q: np.ndarray,
-) -> None:
+) -> float:
     """Newton's method on the five conditions, on the exact chain (finite-difference Jacobian).
 
     Keeps the closed-form answer when Newton does not reduce the conditions (unreachable).
@@ -459,6 +486,8 @@ def _polish(
             q[j] -= step[j]
     if not (norm <= first):
         q[:] = start
+        return first
+    return norm
 
 
 @numba.njit(cache=True, nogil=True)
@@ -556,6 +585,8 @@ def family_ik_kernel(
     pose, work = np.empty((4, 4)), np.empty((4, 4))
     roots = np.empty(MAX_ROOTS)
     q = np.empty(5)
+    trial = np.empty(5)
+    nearest = 0.0
     exact = prm[F.EXACT] != 0.0
     off_axis = prm[F.OFF_AXIS] != 0.0
     for n in range(targets.shape[0]):
@@ -591,20 +622,45 @@ def family_ik_kernel(
         for side in range(2):
             count = 1
             roots[0] = theta_fixed
+            rooted = True
             if need_roots:
                 count = _roll_candidates(
                     prm, target, g, mode, side, phi_ref, sum_ref, lo5, hi5, roots
                 )
+                if count < 0:  # no root: the nearest roll, held during the polish
+                    count, rooted = 1, False
+                    nearest = roots[0]
+                    if not exact and MAX_ROOTS >= 2:
+                        # the exact model may still have a close pair of roots the nearly
+                        # identical ideal model lacks: try Newton from either side first
+                        count = 2
+                        roots[0], roots[1] = nearest - 2e-3, nearest + 2e-3
             for ri in range(count):
                 for elbow in range(2):
                     b = side * per_side + ri * 2 + elbow
                     miss = _branch(
                         prm, target, g, mode, pitch[n], roots[ri], side, elbow, phi_ref, sum_ref, q
                     )
-                    if not exact:
+                    polished = False
+                    if not exact and not rooted:
+                        trial[:] = q
+                        if (
+                            _polish(prm, placements, axes, target, g, mode, pitch[n], np.nan, trial)
+                            < _NEWTON_TOLERANCE
+                        ):
+                            q[:] = trial
+                            polished = True
+                        else:
+                            miss = _branch(
+                                prm, target, g, mode, pitch[n], nearest, side, elbow, phi_ref,
+                                sum_ref, q,
+                            )
+                    if not exact and not polished:
                         rg = roll_given
                         if math.isnan(rg) and (
-                            mode == MODE_PITCH or (mode == MODE_APPROACH and not off_axis)
+                            mode == MODE_PITCH
+                            or (mode == MODE_APPROACH and not off_axis)
+                            or not rooted
                         ):
                             rg = q[4]
                         _polish(prm, placements, axes, target, g, mode, pitch[n], rg, q)
