@@ -50,7 +50,9 @@ def test_branches_verified_by_pinocchio(builtin: Robot) -> None:
         assert result.reachable
         for solution in result.solutions:
             placement = builtin.frame_placement(solution.q)
-            np.testing.assert_allclose(placement[:3], builtin.fk(solution.q)[:3], atol=PINOCCHIO_AGREEMENT)
+            np.testing.assert_allclose(
+                placement[:3], builtin.fk(solution.q)[:3], atol=PINOCCHIO_AGREEMENT
+            )
             assert np.linalg.norm(placement[:3, 3] - pose[:3, 3]) <= POSITION_TOLERANCE
 
 
@@ -60,7 +62,11 @@ def test_own_fk_and_jacobian_match_pinocchio(builtin: Robot) -> None:
     for q in builtin.random_configurations(20, seed=5):
         np.testing.assert_allclose(builtin.fk(q), builtin.frame_placement(q), atol=1e-14)
         expected = pin.computeFrameJacobian(
-            builtin.model, builtin.data, q, builtin.tool_frame_id, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED
+            builtin.model,
+            builtin.data,
+            q,
+            builtin.tool_frame_id,
+            pin.ReferenceFrame.LOCAL_WORLD_ALIGNED,
         )
         np.testing.assert_allclose(builtin.jacobian(q), expected, atol=1e-12)
 
@@ -91,7 +97,7 @@ def test_pitch_targets_round_trip(builtin: Robot) -> None:
     h0 = np.array(family.pitch_axis)
     h0 = np.cross(k, h0)
     angle = family.signs[0] * q[:, 0]
-    h = (np.cos(angle)[:, None] * h0 + np.sin(angle)[:, None] * np.cross(k, h0))
+    h = np.cos(angle)[:, None] * h0 + np.sin(angle)[:, None] * np.cross(k, h0)
     pitch = np.arctan2(np.einsum("ni,ni->n", approach, h), -approach @ k)
     batch = builtin.ik_batch(positions=poses[:, :3, 3], pitches=pitch, rolls=q[:, 4])
     gap = np.where(batch.valid[..., None], _wrapped_gap(batch.q, q[:, None, :]), np.inf)

@@ -12,8 +12,16 @@ def _f(x: float) -> str:
     return repr(float(x))
 
 
-def _joint(name: str, parent: str, child: str, xyz: np.ndarray, rpy: tuple[float, float, float],
-           axis: tuple[float, float, float], lower: float, upper: float) -> str:
+def _joint(
+    name: str,
+    parent: str,
+    child: str,
+    xyz: np.ndarray,
+    rpy: tuple[float, float, float],
+    axis: tuple[float, float, float],
+    lower: float,
+    upper: float,
+) -> str:
     return (
         f'  <joint name="{name}" type="revolute">\n'
         f'    <parent link="{parent}"/><child link="{child}"/>\n'
@@ -28,22 +36,58 @@ def random_family_urdf(rng: np.random.Generator, off_axis_tool: bool = True) -> 
     """A yaw-pitch^3-roll arm with random lengths, offsets, signs, built-in angles, zeros, tool."""
     links = "".join(f'  <link name="l{i}"/>\n' for i in range(6)) + '  <link name="tool"/>\n'
     sign = lambda: float(rng.choice([-1.0, 1.0]))  # noqa: E731
-    joints = _joint("j1", "l0", "l1", rng.uniform(-0.03, 0.03, 3) + [0, 0, 0.05],
-                    (0.0, 0.0, rng.uniform(-math.pi, math.pi)), (0, 0, sign()),
-                    -2.5, 2.5)
+    joints = _joint(
+        "j1",
+        "l0",
+        "l1",
+        rng.uniform(-0.03, 0.03, 3) + [0, 0, 0.05],
+        (0.0, 0.0, rng.uniform(-math.pi, math.pi)),
+        (0, 0, sign()),
+        -2.5,
+        2.5,
+    )
     # pitch joints about +-y; built-in angles about y keep the axes parallel; any offsets
-    joints += _joint("j2", "l1", "l2", rng.uniform(-0.03, 0.03, 3),
-                     (0.0, rng.uniform(-1, 1), 0.0), (0, sign(), 0), -2.0, 2.0)
-    joints += _joint("j3", "l2", "l3",
-                     np.array([rng.uniform(0.08, 0.2), rng.uniform(-0.03, 0.03), rng.uniform(-0.04, 0.04)]),
-                     (0.0, rng.uniform(-1, 1), 0.0), (0, sign(), 0), -2.6, 2.6)
-    joints += _joint("j4", "l3", "l4",
-                     np.array([rng.uniform(0.08, 0.2), rng.uniform(-0.03, 0.03), rng.uniform(-0.04, 0.04)]),
-                     (0.0, rng.uniform(-1, 1), 0.0), (0, sign(), 0), -2.0, 2.0)
+    joints += _joint(
+        "j2",
+        "l1",
+        "l2",
+        rng.uniform(-0.03, 0.03, 3),
+        (0.0, rng.uniform(-1, 1), 0.0),
+        (0, sign(), 0),
+        -2.0,
+        2.0,
+    )
+    joints += _joint(
+        "j3",
+        "l2",
+        "l3",
+        np.array([rng.uniform(0.08, 0.2), rng.uniform(-0.03, 0.03), rng.uniform(-0.04, 0.04)]),
+        (0.0, rng.uniform(-1, 1), 0.0),
+        (0, sign(), 0),
+        -2.6,
+        2.6,
+    )
+    joints += _joint(
+        "j4",
+        "l3",
+        "l4",
+        np.array([rng.uniform(0.08, 0.2), rng.uniform(-0.03, 0.03), rng.uniform(-0.04, 0.04)]),
+        (0.0, rng.uniform(-1, 1), 0.0),
+        (0, sign(), 0),
+        -2.0,
+        2.0,
+    )
     # roll about +-x (perpendicular to y), with a built-in angle about y
-    joints += _joint("j5", "l4", "l5",
-                     np.array([rng.uniform(0.0, 0.05), rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02)]),
-                     (0.0, rng.uniform(-1, 1), 0.0), (sign(), 0, 0), -2.8, 2.8)
+    joints += _joint(
+        "j5",
+        "l4",
+        "l5",
+        np.array([rng.uniform(0.0, 0.05), rng.uniform(-0.02, 0.02), rng.uniform(-0.02, 0.02)]),
+        (0.0, rng.uniform(-1, 1), 0.0),
+        (sign(), 0, 0),
+        -2.8,
+        2.8,
+    )
     tool_xyz = np.array([rng.uniform(0.02, 0.1), 0.0, 0.0])
     if off_axis_tool:
         tool_xyz[1:] = rng.uniform(-0.012, 0.012, 2)

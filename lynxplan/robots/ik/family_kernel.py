@@ -29,8 +29,18 @@ from lynxplan.robots.chain import chain_fk
 MODE_POSE, MODE_APPROACH, MODE_PITCH = 0, 1, 2
 #: Uniform cells over the roll range on which the roots of the roll equation are bracketed.
 ROOT_GRID = 48
+#: Cells where the roll equation changes by more than FAST_CHANGE are split this many times.
+SUBDIVISION = 16
+#: Samples between a grid point and a reach boundary of the yaw (quadratically spaced).
+BOUNDARY_SAMPLES = 32
+#: Near-roots of the ideal model (|f| below this at a local extremum) are tried on the exact one.
+NEAR_ROOT = 5e-3
+FAST_CHANGE = 0.25
+#: Roots where the tool point misses the yaw circle by more than this [m] are not solutions
+#: (more than the ~1e-7 m the exact model differs from the ideal one by).
+CLAMPED_ROOT_TOLERANCE = 1e-6
 #: At most this many roll roots per side are kept (each gives two elbow branches).
-MAX_ROOTS = 4
+MAX_ROOTS = 6
 TWO_PI = 2.0 * math.pi
 _NEWTON_STEPS = 40
 _NEWTON_TOLERANCE = 1e-14
@@ -181,7 +191,32 @@ def _roll_equation(
     big_phi, out = _pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
     if mode == MODE_APPROACH:
         return out
-    return _wrap(_best_roll(prm, g, phi, big_phi) - theta)
+    # sin, not the wrapped difference: continuous through +-pi; roots at pi are rejected later
+    return math.sin(_best_roll(prm, g, phi, big_phi) - theta)
+
+
+@numba.njit(cache=True, nogil=True)
+def _roll_mismatch(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    theta: float,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+) -> float:
+    """|wrapped best-roll difference| (pose) or |out-of-plane approach| (approach)."""
+    if mode == MODE_APPROACH:
+        return abs(_roll_equation(prm, target, g, mode, theta, side, phi_ref, sum_ref))
+    d0, d1, d2 = (
+        target[0, 3] - prm[F.C1],
+        target[1, 3] - prm[F.C1 + 1],
+        target[2, 3] - prm[F.C1 + 2],
+    )
+    phi, _ = _yaw(prm, d0, d1, d2, theta, side, phi_ref)
+    big_phi, _ = _pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
+    return abs(_wrap(_best_roll(prm, g, phi, big_phi) - theta))
 
 
 @numba.njit(cache=True, nogil=True)
@@ -224,8 +259,16 @@ def _refine_root(
 
 @numba.njit(cache=True, nogil=True)
 def _golden(
-    prm: np.ndarray, target: np.ndarray, g: np.ndarray, mode: int, side: int, phi_ref: float,
-    sum_ref: float, a: float, b: float, sign: float,
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+    a: float,
+    b: float,
+    sign: float,
 ) -> float:
     """Minimiser of sign * f on [a, b] (golden-section search)."""
     inv = 0.5 * (math.sqrt(5.0) - 1.0)
@@ -243,9 +286,62 @@ def _golden(
 
 
 @numba.njit(cache=True, nogil=True)
+def _lateral_miss(
+    prm: np.ndarray, target: np.ndarray, theta: float, side: int, phi_ref: float
+) -> float:
+    d0, d1, d2 = (
+        target[0, 3] - prm[F.C1],
+        target[1, 3] - prm[F.C1 + 1],
+        target[2, 3] - prm[F.C1 + 2],
+    )
+    return _yaw(prm, d0, d1, d2, theta, side, phi_ref)[1]
+
+
+@numba.njit(cache=True, nogil=True)
+def _keep_root(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+    x: float,
+    roots: np.ndarray,
+    count: int,
+) -> int:
+    """Store root x unless it is a spurious one (best roll opposite, sin = 0 at pi)."""
+    if mode != MODE_APPROACH and (
+        _roll_mismatch(prm, target, g, mode, x, side, phi_ref, sum_ref) > 0.5 * math.pi
+    ):
+        return count
+    d0, d1, d2 = (
+        target[0, 3] - prm[F.C1],
+        target[1, 3] - prm[F.C1 + 1],
+        target[2, 3] - prm[F.C1 + 2],
+    )
+    _, lateral_miss = _yaw(prm, d0, d1, d2, x, side, phi_ref)
+    if lateral_miss > CLAMPED_ROOT_TOLERANCE:  # the yaw is clamped there: not a solution
+        return count
+    if count < MAX_ROOTS:
+        roots[count] = x
+        roots[MAX_ROOTS + count] = 0.0  # second half: 1 marks a tentative root
+        count += 1
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
 def _roll_candidates(
-    prm: np.ndarray, target: np.ndarray, g: np.ndarray, mode: int, side: int, phi_ref: float,
-    sum_ref: float, lo: float, hi: float, roots: np.ndarray,
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    side: int,
+    phi_ref: float,
+    sum_ref: float,
+    lo: float,
+    hi: float,
+    roots: np.ndarray,
 ) -> int:
     """Every root of the roll equation in [lo, hi] (at most MAX_ROOTS); returns their count.
 
@@ -254,33 +350,66 @@ def _roll_candidates(
     by golden section and both halves bracketed. Without any root, writes the minimiser of |f|
     and returns -1.
     """
-    xs = np.empty(ROOT_GRID + 1)
-    fs = np.empty(ROOT_GRID + 1)
-    for i in range(ROOT_GRID + 1):
-        xs[i] = lo + (hi - lo) * i / ROOT_GRID
-        fs[i] = _roll_equation(prm, target, g, mode, xs[i], side, phi_ref, sum_ref)
+    # uniform grid; cells where f changes fast are split SUBDIVISION times, and cells where
+    # the yaw circle starts or stops being reachable are sampled towards that boundary with a
+    # quadratic spacing (f behaves like the square root of the distance to it there)
+    size = ROOT_GRID * (BOUNDARY_SAMPLES + SUBDIVISION) + 2
+    xs = np.empty(size)
+    fs = np.empty(size)
+    step = (hi - lo) / ROOT_GRID
+    m = 0
+    xs[0] = lo
+    fs[0] = _roll_equation(prm, target, g, mode, lo, side, phi_ref, sum_ref)
+    c0 = _lateral_miss(prm, target, lo, side, phi_ref) > 0.0
+    for i in range(1, ROOT_GRID + 1):
+        x0 = xs[m]
+        x1 = lo + step * i if i < ROOT_GRID else hi
+        f1 = _roll_equation(prm, target, g, mode, x1, side, phi_ref, sum_ref)
+        c1 = _lateral_miss(prm, target, x1, side, phi_ref) > 0.0
+        if c0 != c1:
+            a, b = x0, x1  # a keeps the state of x0
+            for _ in range(60):
+                mid = 0.5 * (a + b)
+                if (_lateral_miss(prm, target, mid, side, phi_ref) > 0.0) == c0:
+                    a = mid
+                else:
+                    b = mid
+            boundary = b if c0 else a  # on the reachable side
+            for j in range(1, BOUNDARY_SAMPLES + 1):
+                if c0:  # clamped -> reachable: from the boundary outwards
+                    x = boundary + (x1 - boundary) * ((j - 1) / BOUNDARY_SAMPLES) ** 2
+                else:  # reachable -> clamped: towards the boundary
+                    x = (
+                        boundary
+                        - (boundary - x0) * ((BOUNDARY_SAMPLES - j) / BOUNDARY_SAMPLES) ** 2
+                    )
+                if x <= xs[m] or x >= x1:
+                    continue
+                m += 1
+                xs[m] = x
+                fs[m] = _roll_equation(prm, target, g, mode, x, side, phi_ref, sum_ref)
+        elif abs(f1 - fs[m]) > FAST_CHANGE:
+            for j in range(1, SUBDIVISION):
+                m += 1
+                xs[m] = x0 + (x1 - x0) * j / SUBDIVISION
+                fs[m] = _roll_equation(prm, target, g, mode, xs[m], side, phi_ref, sum_ref)
+        m += 1
+        xs[m], fs[m] = x1, f1
+        c0 = c1
     count = 0
-    best = 0
-    for i in range(ROOT_GRID + 1):
-        if abs(fs[i]) < abs(fs[best]):
-            best = i
+    for i in range(m + 1):
         if count >= MAX_ROOTS:
             break
         if fs[i] == 0.0:
-            roots[count] = xs[i]
-            count += 1
+            count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xs[i], roots, count)
             continue
-        if i == ROOT_GRID:
+        if i == m:
             break
         f0, f1 = fs[i], fs[i + 1]
-        jump = mode != MODE_APPROACH and (abs(f0) > 0.5 * math.pi or abs(f1) > 0.5 * math.pi)
         if f1 != 0.0 and (f0 < 0.0) != (f1 < 0.0):
-            if not jump:  # a wrap of the best-roll difference through +-pi is not a root
-                roots[count] = _refine_root(
-                    prm, target, g, mode, side, phi_ref, sum_ref, xs[i], f0, xs[i + 1], f1
-                )
-                count += 1
-        elif 0 < i and (fs[i - 1] < 0.0) == (f0 < 0.0) and not jump:
+            x = _refine_root(prm, target, g, mode, side, phi_ref, sum_ref, xs[i], f0, xs[i + 1], f1)
+            count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+        elif 0 < i and (fs[i - 1] < 0.0) == (f0 < 0.0):
             # local extremum of |f| at grid point i: two roots may hide in [x_{i-1}, x_{i+1}]
             if abs(f0) < abs(fs[i - 1]) and abs(f0) <= abs(f1):
                 sign = 1.0 if f0 > 0 else -1.0
@@ -289,23 +418,61 @@ def _roll_candidates(
                 )
                 fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
                 if fm == 0.0:
-                    roots[count] = xm
-                    count += 1
+                    count = _keep_root(
+                        prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count
+                    )
+                elif prm[F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
+                    # the exact model may have a close pair of roots here that the nearly
+                    # identical ideal model lacks: tentative, kept only if Newton converges
+                    for shift in (-2e-3, 2e-3):
+                        before = count
+                        count = _keep_root(
+                            prm,
+                            target,
+                            g,
+                            mode,
+                            side,
+                            phi_ref,
+                            sum_ref,
+                            xm + shift,
+                            roots,
+                            count,
+                        )
+                        if count > before:
+                            roots[MAX_ROOTS + count - 1] = 1.0
                 elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
-                    roots[count] = _refine_root(
+                    x = _refine_root(
                         prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], fs[i - 1], xm, fm
                     )
-                    roots[count + 1] = _refine_root(
+                    count = _keep_root(
+                        prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count
+                    )
+                    x = _refine_root(
                         prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[i + 1], f1
                     )
-                    count += 2
+                    count = _keep_root(
+                        prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count
+                    )
+    best = 0
+    for i in range(m + 1):
+        fs[i] = _roll_mismatch(prm, target, g, mode, xs[i], side, phi_ref, sum_ref)
+        if fs[i] < fs[best]:
+            best = i
     if count > 0:
         return count
-    a, b = xs[max(best - 1, 0)], xs[min(best + 1, ROOT_GRID)]
-    sign = 1.0 if fs[best] > 0 else -1.0
-    xm = _golden(prm, target, g, mode, side, phi_ref, sum_ref, a, b, sign)
-    fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
-    roots[0] = xm if abs(fm) < abs(fs[best]) else xs[best]
+    a, b = xs[max(best - 1, 0)], xs[min(best + 1, m)]
+    inv = 0.5 * (math.sqrt(5.0) - 1.0)
+    for _ in range(60):
+        c, d = b - inv * (b - a), a + inv * (b - a)
+        if _roll_mismatch(prm, target, g, mode, c, side, phi_ref, sum_ref) < _roll_mismatch(
+            prm, target, g, mode, d, side, phi_ref, sum_ref
+        ):
+            b = d
+        else:
+            a = c
+    xm = 0.5 * (a + b)
+    better = _roll_mismatch(prm, target, g, mode, xm, side, phi_ref, sum_ref) < fs[best]
+    roots[0] = xm if better else xs[best]
     return -1
 
 
@@ -462,14 +629,12 @@ def _polish(
     jac = np.empty((5, 5))
     qh = np.empty(5)
     start = q.copy()
-    first = np.inf
-    norm = np.inf
-    for it in range(_NEWTON_STEPS + 1):
-        _conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
-        norm = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
-        if it == 0:
-            first = norm
-        if norm < _NEWTON_TOLERANCE or it == _NEWTON_STEPS or not math.isfinite(norm):
+    qt = np.empty(5)
+    _conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
+    first = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
+    norm = first
+    for _ in range(_NEWTON_STEPS):
+        if norm < _NEWTON_TOLERANCE or not math.isfinite(norm):
             break
         for j in range(5):
             qh[:] = q
@@ -482,8 +647,25 @@ def _polish(
         if abs(np.linalg.det(jac)) < 1e-300:
             break
         step = np.linalg.solve(jac, e)
-        for j in range(5):
-            q[j] -= step[j]
+        # backtracking: the full step unless it increases the conditions
+        t = 1.0
+        accepted = False
+        for _ in range(12):
+            for j in range(5):
+                qt[j] = q[j] - t * step[j]
+            _conditions(
+                prm, placements, axes, target, g, mode, pitch, roll_given, qt, pose, work, e2
+            )
+            trial = max(abs(e2[0]), abs(e2[1]), abs(e2[2]), abs(e2[3]), abs(e2[4]))
+            if trial < norm:
+                q[:] = qt
+                e[:] = e2
+                norm = trial
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            break
     if not (norm <= first):
         q[:] = start
         return first
@@ -583,7 +765,7 @@ def family_ik_kernel(
     rt0 = prm[F.RT0 : F.RT0 + 9]
     g = np.empty((3, 4))  # G = Rt Rt0^T, then the target approach axis
     pose, work = np.empty((4, 4)), np.empty((4, 4))
-    roots = np.empty(MAX_ROOTS)
+    roots = np.empty(2 * MAX_ROOTS)
     q = np.empty(5)
     trial = np.empty(5)
     nearest = 0.0
@@ -642,7 +824,15 @@ def family_ik_kernel(
                         prm, target, g, mode, pitch[n], roots[ri], side, elbow, phi_ref, sum_ref, q
                     )
                     polished = False
-                    if not exact and not rooted:
+                    if need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
+                        # a tentative root: a branch only if Newton converges on the exact model
+                        if (
+                            _polish(prm, placements, axes, target, g, mode, pitch[n], np.nan, q)
+                            >= _NEWTON_TOLERANCE
+                        ):
+                            continue
+                        polished = True
+                    elif not exact and not rooted:
                         trial[:] = q
                         if (
                             _polish(prm, placements, axes, target, g, mode, pitch[n], np.nan, trial)
@@ -652,8 +842,17 @@ def family_ik_kernel(
                             polished = True
                         else:
                             miss = _branch(
-                                prm, target, g, mode, pitch[n], nearest, side, elbow, phi_ref,
-                                sum_ref, q,
+                                prm,
+                                target,
+                                g,
+                                mode,
+                                pitch[n],
+                                nearest,
+                                side,
+                                elbow,
+                                phi_ref,
+                                sum_ref,
+                                q,
                             )
                     if not exact and not polished:
                         rg = roll_given
