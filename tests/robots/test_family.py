@@ -49,19 +49,19 @@ ARM = """<?xml version="1.0"?>
   <link name="l5"/><link name="tool"/>
   <joint name="j1" type="revolute"><parent link="l0"/><child link="l1"/>
     <origin xyz="0 0 0.05" rpy="0 0 {z1}"/><axis xyz="0 0 {s1}"/>
-    <limit lower="-6" upper="6" effort="1" velocity="1"/></joint>
+    <limit lower="{l1}" upper="{u1}" effort="1" velocity="1"/></joint>
   <joint name="j2" type="revolute"><parent link="l1"/><child link="l2"/>
     <origin xyz="0.01 0.002 0.03" rpy="0 {z2} 0"/><axis xyz="0 {s2} 0"/>
-    <limit lower="-6" upper="6" effort="1" velocity="1"/></joint>
+    <limit lower="{l2}" upper="{u2}" effort="1" velocity="1"/></joint>
   <joint name="j3" type="revolute"><parent link="l2"/><child link="l3"/>
     <origin xyz="{x3} 0.01 0" rpy="0 {z3} 0"/><axis xyz="0 {s3} 0"/>
-    <limit lower="-6" upper="6" effort="1" velocity="1"/></joint>
+    <limit lower="{l3}" upper="{u3}" effort="1" velocity="1"/></joint>
   <joint name="j4" type="revolute"><parent link="l3"/><child link="l4"/>
     <origin xyz="{x4} 0 0.004" rpy="0 {z4} 0"/><axis xyz="0 {s4} 0"/>
-    <limit lower="-6" upper="6" effort="1" velocity="1"/></joint>
+    <limit lower="{l4}" upper="{u4}" effort="1" velocity="1"/></joint>
   <joint name="j5" type="revolute"><parent link="l4"/><child link="l5"/>
     <origin xyz="0.03 0 0" rpy="{z5} 0 0"/><axis xyz="{s5} 0 0"/>
-    <limit lower="-3" upper="3" effort="1" velocity="1"/></joint>
+    <limit lower="{l5}" upper="{u5}" effort="1" velocity="1"/></joint>
   <joint name="tj" type="fixed"><parent link="l5"/><child link="tool"/>
     <origin xyz="0.05 0.006 -0.004" rpy="0.1 0.2 0.3"/></joint>
 </robot>
@@ -72,7 +72,13 @@ def _write(path: Path, signs: tuple[int, ...], zeros: tuple[float, ...]) -> Path
     """The same physical arm with joint i's axis flipped (signs[i] = -1) and its zero moved by
     zeros[i] (a built-in rotation about its own axis): q_i' = s_i (q_i - z_i)."""
     z = [repr(float(v)) for v in zeros]
+    signs = tuple(int(v) for v in signs)
+    # the same physical range: base limits [-3, 3] mapped through q' = s (q - z)
+    ends = [sorted((s * (-3.0 - zi), s * (3.0 - zi))) for s, zi in zip(signs, zeros, strict=True)]
+    limits = {f"l{i + 1}": repr(float(e[0])) for i, e in enumerate(ends)}
+    limits.update({f"u{i + 1}": repr(float(e[1])) for i, e in enumerate(ends)})
     text = ARM.format(
+        **limits,
         s1=signs[0],
         s2=signs[1],
         s3=signs[2],

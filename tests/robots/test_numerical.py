@@ -7,7 +7,7 @@ import pytest
 
 from lynxplan.robots import load_robot
 
-CI_POSES = 200
+CI_POSES = 400
 SUCCESS_RATE = 0.995
 
 

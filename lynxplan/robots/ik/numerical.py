@@ -21,7 +21,7 @@ NUMERICAL_POSITION_TOLERANCE = 1e-10
 #: ... and the target orientation (or approach axis) within this [rad].
 NUMERICAL_ORIENTATION_TOLERANCE = 1e-9
 MAX_ITERATIONS = 200
-DEFAULT_STARTS = 24
+DEFAULT_STARTS = 128
 
 
 @numba.njit(cache=True, nogil=True)
