@@ -25,6 +25,7 @@ COMMAND_MODULES = (
     "lynxplan.commands.bench",
     "lynxplan.commands.parallel",
     "lynxplan.commands.scenario_tools",
+    "lynxplan.commands.robots",
 )
 
 

@@ -44,8 +44,8 @@ def _local_axis(joint: Any) -> np.ndarray:
         if short.endswith(suffix) or short.endswith("RUB" + suffix[1:]):
             return np.array(axis, dtype=float)
     if "RevoluteUnaligned" in short or "RevoluteUnboundedUnaligned" in short:
-        axis = np.array(joint.extract().axis, dtype=float)
-        return axis / np.linalg.norm(axis)
+        unaligned = np.array(joint.extract().axis, dtype=float)
+        return np.asarray(unaligned / np.linalg.norm(unaligned), dtype=float)
     raise ModelError(f"joint {joint.id}: type {short} is not revolute; only revolute chains")
 
 

@@ -89,7 +89,8 @@ class RobotIkBatch(NamedTuple):
     """Name of each of the B slots."""
 
 
-class TrackJump(NamedTuple):
+@dataclass(frozen=True)
+class TrackJump:
     """A step of a track where no branch continues the previous configuration.
 
     Attributes:

@@ -272,7 +272,7 @@ class Robot:
         q: (n,) or (N, n) [rad] -> (3,) or (N, 3), unit vectors in the base frame.
         """
         poses = self.fk(q)
-        return poses[..., :3, :3] @ self.approach_in_tool
+        return np.asarray(poses[..., :3, :3] @ self.approach_in_tool)
 
     @property
     def approach_in_tool(self) -> np.ndarray:

@@ -33,6 +33,8 @@ ROOT_GRID = 48
 SUBDIVISION = 16
 #: Samples between a grid point and a reach boundary of the yaw (quadratically spaced).
 BOUNDARY_SAMPLES = 32
+#: Two branches closer than this in every joint are one [rad].
+DUPLICATE_TOLERANCE = 1e-9
 #: Near-roots of the ideal model (|f| below this at a local extremum) are tried on the exact one.
 NEAR_ROOT = 5e-3
 FAST_CHANGE = 0.25
@@ -409,50 +411,46 @@ def _roll_candidates(
         if f1 != 0.0 and (f0 < 0.0) != (f1 < 0.0):
             x = _refine_root(prm, target, g, mode, side, phi_ref, sum_ref, xs[i], f0, xs[i + 1], f1)
             count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
-        elif 0 < i and (fs[i - 1] < 0.0) == (f0 < 0.0):
+        elif (
+            i > 0
+            and (fs[i - 1] < 0.0) == (f0 < 0.0)
+            and abs(f0) < abs(fs[i - 1])
+            and abs(f0) <= abs(f1)
+        ):
             # local extremum of |f| at grid point i: two roots may hide in [x_{i-1}, x_{i+1}]
-            if abs(f0) < abs(fs[i - 1]) and abs(f0) <= abs(f1):
-                sign = 1.0 if f0 > 0 else -1.0
-                xm = _golden(
-                    prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], xs[i + 1], sign
+            sign = 1.0 if f0 > 0 else -1.0
+            xm = _golden(prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], xs[i + 1], sign)
+            fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
+            if fm == 0.0:
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
+            elif prm[F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
+                # the exact model may have a close pair of roots here that the nearly
+                # identical ideal model lacks: tentative, kept only if Newton converges
+                for shift in (-2e-3, 2e-3):
+                    before = count
+                    count = _keep_root(
+                        prm,
+                        target,
+                        g,
+                        mode,
+                        side,
+                        phi_ref,
+                        sum_ref,
+                        xm + shift,
+                        roots,
+                        count,
+                    )
+                    if count > before:
+                        roots[MAX_ROOTS + count - 1] = 1.0
+            elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
+                x = _refine_root(
+                    prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], fs[i - 1], xm, fm
                 )
-                fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
-                if fm == 0.0:
-                    count = _keep_root(
-                        prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count
-                    )
-                elif prm[F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
-                    # the exact model may have a close pair of roots here that the nearly
-                    # identical ideal model lacks: tentative, kept only if Newton converges
-                    for shift in (-2e-3, 2e-3):
-                        before = count
-                        count = _keep_root(
-                            prm,
-                            target,
-                            g,
-                            mode,
-                            side,
-                            phi_ref,
-                            sum_ref,
-                            xm + shift,
-                            roots,
-                            count,
-                        )
-                        if count > before:
-                            roots[MAX_ROOTS + count - 1] = 1.0
-                elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
-                    x = _refine_root(
-                        prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], fs[i - 1], xm, fm
-                    )
-                    count = _keep_root(
-                        prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count
-                    )
-                    x = _refine_root(
-                        prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[i + 1], f1
-                    )
-                    count = _keep_root(
-                        prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count
-                    )
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+                x = _refine_root(
+                    prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[i + 1], f1
+                )
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
     best = 0
     for i in range(m + 1):
         fs[i] = _roll_mismatch(prm, target, g, mode, xs[i], side, phi_ref, sum_ref)
@@ -668,8 +666,8 @@ def _polish(
             break
     if not (norm <= first):
         q[:] = start
-        return first
-    return norm
+        return float(first)
+    return float(norm)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -874,6 +872,17 @@ def family_ik_kernel(
                     for i in range(3):
                         d = pose[i, 3] - target[i, 3]
                         err += d * d
+                    duplicate = False
+                    for b2 in range(b):
+                        if valid[n, b2]:
+                            gap = 0.0
+                            for j in range(5):
+                                gap = max(gap, abs(q_out[n, b2, j] - q[j]))
+                            duplicate = duplicate or gap < DUPLICATE_TOLERANCE
+                    if duplicate:  # the same branch reached twice (merged roots, a fold)
+                        for j in range(5):
+                            q_out[n, b, j] = np.nan
+                        continue
                     valid[n, b] = True
                     within[n, b] = inside
                     position_error[n, b] = math.sqrt(err)
