@@ -14,14 +14,26 @@ __version__ = "0.1.0"
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm
+    from lynxplan.planning.planner import PlannedTrajectory, plan
     from lynxplan.robots import Robot, load_robot
+    from lynxplan.scenarios.runner import run_scenario
 
-__all__ = ["Arm", "LynxplanError", "Robot", "__version__", "load_arm", "load_robot"]
+__all__ = [
+    "Arm",
+    "LynxplanError",
+    "PlannedTrajectory",
+    "Robot",
+    "__version__",
+    "load_arm",
+    "load_robot",
+    "plan",
+    "run_scenario",
+]
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy attributes: ``lynxplan.load_arm``, ``lynxplan.Arm``, ``lynxplan.load_robot``,
-    ``lynxplan.Robot``."""
+    """Lazy attributes: ``load_arm``, ``Arm``, ``load_robot``, ``Robot``, ``run_scenario``,
+    ``plan``, ``PlannedTrajectory``."""
     if name in ("load_arm", "Arm"):
         from lynxplan.arm import model
 
@@ -30,4 +42,12 @@ def __getattr__(name: str) -> Any:
         from lynxplan import robots
 
         return getattr(robots, name)
+    if name in ("plan", "PlannedTrajectory"):
+        from lynxplan.planning import planner
+
+        return getattr(planner, name)
+    if name == "run_scenario":
+        from lynxplan.scenarios.runner import run_scenario
+
+        return run_scenario
     raise AttributeError(f"module 'lynxplan' has no attribute {name!r}")

@@ -2,14 +2,20 @@
 
 Each sub-command lives in a module of :mod:`lynxplan.commands` that exposes
 ``register(subparsers)``; the handler it sets returns the process exit code.
+
+Whatever happens, the user sees at most one line on stderr (``--debug`` adds the traceback) and
+one of the documented exit codes (:data:`EXIT_CODES`).
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import importlib
+import os
 import re
 import sys
+import traceback
 from collections.abc import Sequence
 from typing import Any
 
@@ -18,6 +24,25 @@ from lynxplan.exceptions import LynxplanError
 
 _NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 
+#: Success.
+EXIT_OK = 0
+#: The run completed, and at least one ``expect:`` entry did not hold.
+EXIT_EXPECTATION_FAILED = 1
+#: Bad input: usage error, invalid value, malformed or unreadable file, resource limit.
+EXIT_BAD_INPUT = 2
+#: An internal error (a bug in lynxplan): please report it.
+EXIT_BUG = 3
+#: Interrupted (Ctrl-C).
+EXIT_INTERRUPTED = 130
+
+EXIT_CODES: dict[int, str] = {
+    EXIT_OK: "success",
+    EXIT_EXPECTATION_FAILED: "the run completed but an expectation (expect:) failed",
+    EXIT_BAD_INPUT: "bad input: usage, value, file or resource limit (one line on stderr)",
+    EXIT_BUG: "internal error, a bug in lynxplan: please report it (rerun with --debug)",
+    EXIT_INTERRUPTED: "interrupted (Ctrl-C)",
+}
+
 COMMAND_MODULES = (
     "lynxplan.commands.arm",
     "lynxplan.commands.workspace",
@@ -25,6 +50,7 @@ COMMAND_MODULES = (
     "lynxplan.commands.bench",
     "lynxplan.commands.parallel",
     "lynxplan.commands.scenario_tools",
+    "lynxplan.commands.serve",
     "lynxplan.commands.robots",
 )
 
@@ -38,8 +64,13 @@ class _Parser(argparse.ArgumentParser):
         self._negative_number_matcher = _NEGATIVE_NUMBER
 
     def error(self, message: str) -> None:  # type: ignore[override]
-        sys.stderr.write(f"{self.prog}: error: {message}\n")
-        raise SystemExit(2)
+        sys.stderr.write(f"{self.prog}: error: {_one_line(message)}\n")
+        raise SystemExit(EXIT_BAD_INPUT)
+
+
+def _epilog() -> str:
+    lines = ["exit codes:"] + [f"  {code:<4} {meaning}" for code, meaning in EXIT_CODES.items()]
+    return "\n".join(lines)
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -47,8 +78,15 @@ def build_parser() -> argparse.ArgumentParser:
     parser = _Parser(
         prog="lynxplan",
         description="Modelling and planning for a 5-DOF arm and a planar 3-RRR parallel robot.",
+        epilog=_epilog(),
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     parser.add_argument("--version", action="version", version=f"lynxplan {__version__}")
+    parser.add_argument(
+        "--debug",
+        action="store_true",
+        help="show the full traceback of an error (accepted anywhere on the command line)",
+    )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     subparsers.required = True
     for name in COMMAND_MODULES:
@@ -56,26 +94,65 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+def _one_line(message: str) -> str:
+    """``message`` folded onto one line (error messages may quote multi-line values)."""
+    return " ".join(str(message).split())
+
+
+def _split_debug(argv: Sequence[str]) -> tuple[list[str], bool]:
+    """Remove ``--debug`` from anywhere before a ``--`` separator."""
+    args = list(argv)
+    end = args.index("--") if "--" in args else len(args)
+    debug = "--debug" in args[:end]
+    return [a for i, a in enumerate(args) if not (i < end and a == "--debug")], debug
+
+
+def _report(message: str, debug: bool) -> None:
+    if debug:
+        traceback.print_exc()
+    sys.stderr.write(f"lynxplan: {message}\n")
+
+
 def main(argv: Sequence[str] | None = None) -> int:
-    """Run the CLI; returns the exit code (0 ok, 1 expectation failed, 2 bad input)."""
-    parser = build_parser()
-    args = parser.parse_args(argv)
+    """Run the CLI; returns the exit code (see :data:`EXIT_CODES`).
+
+    Never raises (except SystemExit from ``--help``/``--version`` handled here too) and never
+    lets a traceback reach the user unless ``--debug`` is given.
+    """
+    args_list, debug = _split_debug(sys.argv[1:] if argv is None else argv)
     try:
+        try:
+            args = build_parser().parse_args(args_list)
+        except SystemExit as exc:  # --help, --version, usage errors (already printed)
+            return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
         code: int = args.handler(args)
+        return code
     except LynxplanError as exc:
-        sys.stderr.write(f"lynxplan: error: {exc}\n")
-        return 2
+        _report(f"error: {_one_line(str(exc))}", debug)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        _report("interrupted", debug)
+        return EXIT_INTERRUPTED
+    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
+        # Python flushes stdout at exit and would fail again: point it at /dev/null.
+        with contextlib.suppress(OSError, ValueError):
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return EXIT_OK
     except OSError as exc:  # e.g. an output folder that cannot be created
         where = f": {exc.filename}" if exc.filename else ""
-        sys.stderr.write(f"lynxplan: error: {exc.strerror or exc}{where}\n")
-        return 2
-    except KeyboardInterrupt:
-        sys.stderr.write("lynxplan: interrupted\n")
-        return 130
-    except BrokenPipeError:  # output piped into e.g. `head`, which closed early
-        sys.stderr.close()
-        return 0
-    return code
+        _report(f"error: {_one_line(exc.strerror or str(exc))}{where}", debug)
+        return EXIT_BAD_INPUT
+    except SystemExit as exc:
+        return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
+    except (MemoryError, RecursionError, Exception) as exc:  # a bug: guards must prevent these
+        detail = _one_line(str(exc))[:200]
+        _report(
+            f"internal error ({type(exc).__name__}{': ' + detail if detail else ''}); this is a "
+            f"bug in lynxplan {__version__}: please file a bug report with the command line and "
+            "the output of the same command with --debug",
+            debug,
+        )
+        return EXIT_BUG
 
 
 if __name__ == "__main__":

@@ -128,14 +128,35 @@ class ScenarioError(LynxplanError):
         file: Path of the scenario file.
         location: Key path inside the file, e.g. ``"segments[3].ta"``, or ``""``.
         reason: What is wrong.
+        line: 1-based line of the key in the file, when known.
     """
 
-    def __init__(self, file: str, location: str, reason: str) -> None:
+    def __init__(self, file: str, location: str, reason: str, line: int | None = None) -> None:
         self.file = file
         self.location = location
         self.reason = reason
+        self.line = line
         where = f"{file}, {location}" if location else file
-        super().__init__(f"scenario {where}: {reason}")
+        at = f" (line {line})" if line is not None else ""
+        super().__init__(f"scenario {where}: {reason}{at}")
+
+
+class ScenarioValueError(LynxplanError):
+    """A scenario value found unusable while running it (e.g. an unreachable waypoint).
+
+    The scenario runner turns it into a :class:`ScenarioError` naming the file and the line.
+
+    Attributes:
+        loc: Key path inside the scenario, e.g. ``("waypoints", "O2", "pose")``.
+        reason: What is wrong.
+        value: The offending value, or None.
+    """
+
+    def __init__(self, loc: tuple[str | int, ...], reason: str, value: object = None) -> None:
+        self.loc = loc
+        self.reason = reason
+        self.value = value
+        super().__init__(reason)
 
 
 class TimingError(InputError):
@@ -208,36 +229,35 @@ def _degrees(theta: tuple[float, ...]) -> str:
     return ", ".join(f"{math.degrees(t):.4f}" for t in theta)
 
 
-class DegenerateForwardKinematicsError(KinematicsError):
-    """Forward kinematics of the 3-RRR has a continuum of solutions (architecture singularity).
+class _ActuatedAnglesError(KinematicsError):
+    """A 3-RRR forward-kinematics problem with given actuated angles.
 
     Attributes:
         theta: The actuated angles, shape (3,), in [rad].
     """
 
-    def __init__(self, theta: tuple[float, float, float]) -> None:
-        self.theta = theta
-        degrees = _degrees(theta)
-        super().__init__(
-            f"parallel robot: the actuated angles ({degrees}) deg leave the platform free to move "
-            "(the closure polynomial vanishes identically); forward kinematics is not finite"
-        )
-
-
-class NoAssemblyModeError(KinematicsError):
-    """The actuated angles of the 3-RRR admit no real assembly mode.
-
-    Attributes:
-        theta: The actuated angles, shape (3,), in [rad].
-    """
+    _problem = ""
 
     def __init__(self, theta: tuple[float, float, float]) -> None:
         self.theta = theta
-        degrees = _degrees(theta)
         super().__init__(
-            f"parallel robot: the actuated angles ({degrees}) deg admit no assembly mode "
-            "(the distal links cannot all meet the platform)"
+            f"parallel robot: the actuated angles ({_degrees(theta)}) deg {self._problem}"
         )
+
+
+class DegenerateForwardKinematicsError(_ActuatedAnglesError):
+    """Forward kinematics of the 3-RRR has a continuum of solutions (architecture singularity)."""
+
+    _problem = (
+        "leave the platform free to move (the closure polynomial vanishes identically); "
+        "forward kinematics is not finite"
+    )
+
+
+class NoAssemblyModeError(_ActuatedAnglesError):
+    """The actuated angles of the 3-RRR admit no real assembly mode."""
+
+    _problem = "admit no assembly mode (the distal links cannot all meet the platform)"
 
 
 class RetimingError(LynxplanError):
@@ -283,6 +303,102 @@ class CollisionModelError(LynxplanError):
 class TrajectoryCheckError(InputError):
     """A trajectory handed to the collision or limit check is malformed (e.g. times not
     strictly increasing)."""
+
+
+# -- motion planning (lynxplan.planning) ---------------------------------------------------------
+
+
+class PlanningError(LynxplanError):
+    """Base class of the motion planner's errors."""
+
+
+class ConfigurationOutsideLimitsError(InputError, PlanningError):
+    """A start or goal configuration has a joint outside its position limits.
+
+    Attributes:
+        what: ``"start"`` or ``"goal"``.
+        joint: Joint name.
+        value: The joint's value, in [rad].
+        lower: Lower limit, in [rad].
+        upper: Upper limit, in [rad].
+    """
+
+    def __init__(self, what: str, joint: str, value: float, lower: float, upper: float) -> None:
+        self.what, self.joint, self.value = what, joint, value
+        self.lower, self.upper = lower, upper
+        super().__init__(
+            f"{what}: joint {joint} = {value:.6g} rad is outside its limits "
+            f"[{lower:.6g}, {upper:.6g}] rad"
+        )
+
+
+class StateInCollisionError(InputError, PlanningError):
+    """The start or goal configuration collides (or is closer than the required clearance).
+
+    Attributes:
+        what: ``"start"`` or ``"goal"`` (``"goal (every IK branch)"`` for a pose goal).
+        link: URDF link of the colliding primitive.
+        obstacle: Obstacle name (``"self:<geometry>"`` for a self-collision).
+        penetration_depth: Penetration depth (exact, coal), in [m]; negative: the distance by
+            which a collision-free state misses the required clearance.
+        clearance: The required clearance, in [m].
+    """
+
+    def __init__(
+        self, what: str, link: str, obstacle: str, penetration_depth: float, clearance: float
+    ) -> None:
+        self.what, self.link, self.obstacle = what, link, obstacle
+        self.penetration_depth, self.clearance = penetration_depth, clearance
+        if penetration_depth >= 0:
+            detail = f"penetration depth {penetration_depth * 1e3:.3f} mm"
+        else:
+            detail = (
+                f"distance {-penetration_depth * 1e3:.3f} mm is below the required clearance "
+                f"{clearance * 1e3:.3f} mm"
+            )
+        super().__init__(f"{what} is in collision: link {link} with {obstacle}, {detail}")
+
+
+class GoalUnreachableError(PlanningError):
+    """No IK branch of a pose goal is within the joint limits.
+
+    Attributes:
+        reason: What IK reported.
+    """
+
+    def __init__(self, reason: str) -> None:
+        self.reason = reason
+        super().__init__(f"goal: no configuration reaches it: {reason}")
+
+
+class PlanningFailed(PlanningError):  # noqa: N818 (the name the issue gives)
+    """The planner found no collision-free path within its time and node budgets.
+
+    Attributes:
+        nodes: Number of tree nodes created (both trees).
+        iterations: Number of sampling iterations.
+        elapsed: Planning time spent, in [s].
+        reason: ``"time limit"`` or ``"node limit"`` (with the budget).
+    """
+
+    def __init__(self, nodes: int, iterations: int, elapsed: float, reason: str) -> None:
+        self.nodes, self.iterations, self.elapsed, self.reason = nodes, iterations, elapsed, reason
+        super().__init__(
+            f"no collision-free path found: {reason} reached after {nodes} nodes "
+            f"({iterations} iterations, {elapsed * 1e3:.1f} ms)"
+        )
+
+
+class PathVerificationError(PlanningError):
+    """The exact collision check rejected a planned path (a planner bug: never expected).
+
+    Attributes:
+        detail: The contact or uncertified interval found.
+    """
+
+    def __init__(self, detail: str) -> None:
+        self.detail = detail
+        super().__init__(f"planned path failed the exact collision check: {detail}")
 
 
 class TaskError(InputError):

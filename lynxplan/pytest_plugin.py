@@ -17,7 +17,7 @@ import pytest
 import yaml
 
 from lynxplan.exceptions import LynxplanError
-from lynxplan.scenario import Outcome
+from lynxplan.scenarios.base import Result
 
 #: Folder name under which YAML files are collected without being named on the command line.
 SCENARIO_FOLDER = "scenarios"
@@ -28,10 +28,10 @@ class ExpectationFailedError(AssertionError):
 
     Attributes:
         path: The scenario file.
-        outcome: What the run produced (summary and failed expectations).
+        outcome: What the run produced (its expectations, checked).
     """
 
-    def __init__(self, path: Path, outcome: Outcome) -> None:
+    def __init__(self, path: Path, outcome: Result) -> None:
         self.path = path
         self.outcome = outcome
         lines = "\n".join(f"  - {failure}" for failure in outcome.failed_expectations)
@@ -40,14 +40,14 @@ class ExpectationFailedError(AssertionError):
         )
 
 
-def run_scenario_file(path: str | Path) -> Outcome:
-    """Run a scenario the way the plugin does (quick, nothing written); returns its outcome."""
-    from lynxplan.runner import run_scenario
+def run_scenario_file(path: str | Path) -> Result:
+    """Run a scenario the way the plugin does (quick, nothing written); returns its result."""
+    from lynxplan.scenarios import run_scenario
 
     return run_scenario(path, None, quick=True)
 
 
-def check_scenario_file(path: str | Path) -> Outcome:
+def check_scenario_file(path: str | Path) -> Result:
     """Run a scenario and raise :class:`ExpectationFailedError` if an expectation fails.
 
     Raises:

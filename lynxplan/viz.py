@@ -38,7 +38,8 @@ _Y_TO_Z = np.array([[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 0, 0, 1
 
 @dataclass(frozen=True)
 class WritingPlane:
-    """A flat rectangle drawn in the scene (not an obstacle).
+    """A flat rectangle drawn in the scene (not an obstacle): the one writing-plane type, used by
+    the task plots and the meshcat export.
 
     Attributes:
         point: A point of the plane (the rectangle's centre), shape (3,), in [m].
@@ -50,15 +51,25 @@ class WritingPlane:
     normal: np.ndarray
     size: tuple[float, float] = (0.3, 0.3)
 
+    @classmethod
+    def tilted(
+        cls, point: Any, tilt: float, size: tuple[float, float] = (0.3, 0.3)
+    ) -> WritingPlane:
+        """A plane through ``point`` (3,) [m] tilted by ``tilt`` [rad] to x-y, rising along +y."""
+        normal = np.array([0.0, -np.sin(tilt), np.cos(tilt)])
+        return cls(np.asarray(point, float), normal, (float(size[0]), float(size[1])))
+
+    @property
+    def rotation(self) -> np.ndarray:
+        """Plane axes (columns: in-plane x kept horizontal, in-plane y, unit normal), (3, 3)."""
+        return _frame_from_normal(np.asarray(self.normal, float))
+
 
 def tilted_plane(
     point: Any, tilt_deg: float = 20.0, size: tuple[float, float] = (0.3, 0.3)
 ) -> WritingPlane:
     """A plane through ``point`` (3,) [m] tilted by ``tilt_deg`` [deg] to x-y, rising along +y."""
-    tilt = np.radians(tilt_deg)
-    return WritingPlane(
-        np.asarray(point, float), np.array([0.0, -np.sin(tilt), np.cos(tilt)]), size
-    )
+    return WritingPlane.tilted(point, float(np.radians(tilt_deg)), size)
 
 
 def _frame_from_normal(normal: np.ndarray) -> np.ndarray:
@@ -243,7 +254,7 @@ def _draw_plane(vis: Any, plane: WritingPlane) -> None:
     import meshcat.geometry as mg
 
     pose = np.eye(4)
-    pose[:3, :3] = _frame_from_normal(np.asarray(plane.normal, float))
+    pose[:3, :3] = plane.rotation
     pose[:3, 3] = plane.point
     material = mg.MeshLambertMaterial(color=PLANE_COLOUR, opacity=0.35, transparent=True)
     vis["plane"].set_object(mg.Box([plane.size[0], plane.size[1], 0.001]), material)

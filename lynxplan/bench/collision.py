@@ -26,18 +26,6 @@ def _ok_task_samples() -> Any:
     return ok_task_plan().sample(RATE)
 
 
-def _spec_walls() -> list[Any]:
-    from lynxplan.collision import axis_aligned_box
-    from lynxplan.units import INCH
-
-    return [
-        axis_aligned_box(
-            "wall_letters", np.array([-0.2, 8, -2]) * INCH, np.array([0.4, 10, 3.5]) * INCH
-        ),
-        axis_aligned_box("wall_home", np.array([5, 4.5, -2]) * INCH, np.array([10, 1, 8]) * INCH),
-    ]
-
-
 def naive_check(arm: Any, obstacles: list[Any], q: np.ndarray) -> tuple[float, int]:
     """Per sample: FK, new FCL objects, every pair's distance; then the between-sample test.
 
@@ -83,12 +71,13 @@ def run(quick: bool) -> list[Figure]:
     """Measure the collision figures."""
     from lynxplan.arm import load_arm
     from lynxplan.collision import CollisionWorld, check_trajectory
+    from lynxplan.trajectory.ok_task import ok_task_walls
 
     arm = load_arm()
     samples = _ok_task_samples()
     q, t, segment = samples.q, samples.t, samples.segment
     bound = np.abs(samples.qdd).max(axis=0)
-    walls = _spec_walls()
+    walls = ok_task_walls()
     repeats = 3 if quick else 7
     figures = []
     fast: dict[str, float] = {}

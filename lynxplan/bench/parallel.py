@@ -22,7 +22,7 @@ def run(quick: bool) -> list[Figure]:
     """Measure the parallel-robot figures."""
     from lynxplan.parallel.fk import solve_fk_batch
     from lynxplan.parallel.geometry import ParallelGeometry
-    from lynxplan.parallel.ik import ik_kernel, kernel_constants, solve_ik_batch
+    from lynxplan.parallel.ik import ik_kernel, leg_constants, solve_ik_batch
     from lynxplan.parallel.workspace import constant_orientation_workspace, orientation_stack
 
     geometry = ParallelGeometry()
@@ -31,10 +31,9 @@ def run(quick: bool) -> list[Figure]:
 
     count = 100_000 if quick else 400_000
     poses = _poses(count)
-    base, phase = kernel_constants(geometry)
+    legs = leg_constants(geometry)
     out, distance = np.empty((count, 8, 3)), np.empty((count, 3))
-    args = (geometry.platform_circumradius, geometry.proximal, geometry.distal, out, distance)
-    seconds = median_seconds(lambda: ik_kernel(poses, base, phase, *args), repeats=repeats)
+    seconds = median_seconds(lambda: ik_kernel(poses, legs, out, distance), repeats=repeats)
     rate = count / seconds
     figures.append(
         Figure(SECTION, "IK kernel, all 8 modes", rate, "poses/s", ">= 3e6", rate >= 3e6)

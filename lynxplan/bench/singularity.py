@@ -23,16 +23,16 @@ _SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "singularity_lin
 def run(quick: bool) -> list[Figure]:
     """Measure µs per step for each strategy; ``quick`` shortens the Python reference runs."""
     from lynxplan.arm import load_arm
-    from lynxplan.scenario import load_scenario
+    from lynxplan.scenarios import load_scenario
+    from lynxplan.scenarios.singularity import Scenario, build_problem
     from lynxplan.singularity import (
         STRATEGY_NAMES,
         Strategy,
         run_reference,
         run_resolved_rate,
     )
-    from lynxplan.singularity.scenario import Scenario, build_problem
 
-    _, scenario = load_scenario(_SCENARIO)
+    scenario = load_scenario(_SCENARIO).scenario
     problem = build_problem(cast(Scenario, scenario))
     arm = load_arm()
     steps = 10_000

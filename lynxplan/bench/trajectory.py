@@ -18,26 +18,6 @@ from lynxplan.bench import Figure, median_seconds
 RATE = 1000.0
 
 
-def _scalar_lspb(t: float, tt: float, ta: float) -> tuple[float, float, float]:
-    """The report's normalised LSPB at time since start ``t``, pure Python (SPEC Part 2)."""
-    tau, big_t = 0.5 * ta, tt - ta
-    x = min(max(t, 0.0), tt) - tau  # report time over [-tau, T + tau]
-    if x <= tau:
-        return (
-            (x + tau) ** 2 / (4 * big_t * tau),
-            (x + tau) / (2 * big_t * tau),
-            1 / (2 * big_t * tau),
-        )
-    if x < big_t - tau:
-        return x / big_t, 1 / big_t, 0.0
-    end = x - big_t + tau
-    return (
-        x / big_t - end**2 / (4 * big_t * tau),
-        1 / big_t - end / (2 * big_t * tau),
-        -1 / (2 * big_t * tau),
-    )
-
-
 def _loop_sample(plan: object) -> np.ndarray:
     """Per-sample Python loop producing the same samples as ``plan.sample(RATE)``."""
     from lynxplan.arm.geometry import ArmGeometry
@@ -45,6 +25,7 @@ def _loop_sample(plan: object) -> np.ndarray:
     from lynxplan.arm.kinematics import fk_kernel
     from lynxplan.constants import LIMIT_SNAP_TOLERANCE
     from lynxplan.trajectory.line import LineSegment
+    from lynxplan.trajectory.lspb import unit_lspb_scalar
 
     geometry = ArmGeometry()
     lower = plan.limits.position[:, 0].copy()  # type: ignore[attr-defined]
@@ -67,7 +48,7 @@ def _loop_sample(plan: object) -> np.ndarray:
         while index < len(segments) - 1 and t >= starts[index + 1]:
             index += 1
         seg = segments[index]
-        s, sd, sdd = _scalar_lspb(t - starts[index], seg.timing.tt, seg.timing.ta)
+        s, sd, sdd = unit_lspb_scalar(t - starts[index], seg.timing)
         if isinstance(seg, LineSegment):
             p0, p1 = seg.T_start[:3, 3], seg.T_end[:3, 3]
             p = p0 + s * (p1 - p0)
@@ -83,19 +64,7 @@ def _loop_sample(plan: object) -> np.ndarray:
             reference[4] = seg.roll[0] + s * (seg.roll[1] - seg.roll[0])
             ik_single_kernel(target, reference, params, 1, rows, scalars)  # 1: approach only
             q = rows[int(scalars[4]), :5].copy()
-            # Same interpolation as LineSegment.path_derivatives, for one s.
-            grid = seg.grid
-            h = grid.s[1] - grid.s[0]
-            i = min(int(s / h), grid.s.size - 2)
-            u = (s - grid.s[i]) / h
-            f0, f1, m0, m1 = grid.dq_ds[i], grid.dq_ds[i + 1], grid.d2q_ds2[i], grid.d2q_ds2[i + 1]
-            first = (
-                (2 * u**3 - 3 * u**2 + 1) * f0
-                + (u**3 - 2 * u**2 + u) * h * m0
-                + (3 * u**2 - 2 * u**3) * f1
-                + (u**3 - u**2) * h * m1
-            )
-            second = m0 + u * (m1 - m0)
+            first, second = seg.path_derivatives(s)
             qd, qdd = first * sd, first * sdd + second * sd * sd
         else:
             delta = seg.q_end - seg.q_start

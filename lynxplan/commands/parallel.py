@@ -116,7 +116,7 @@ def handle_workspace(args: argparse.Namespace) -> int:
     """Compute the workspace, write its PNG, print area and point count."""
     from lynxplan.parallel.plots import plot_workspace
     from lynxplan.parallel.workspace import constant_orientation_workspace
-    from lynxplan.runner import staged_outputs
+    from lynxplan.scenarios.outputs import staged_outputs
 
     alpha_deg = parse_finite(args.alpha, "--alpha")
     step = parse_finite(args.step, "--step")

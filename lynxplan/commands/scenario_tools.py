@@ -1,4 +1,4 @@
-"""``lynxplan schema [KIND]`` and ``lynxplan validate FILE``: the scenario schemas and a checker."""
+"""``lynxplan schema [KIND|report]`` and ``lynxplan validate FILE``: schemas and a checker."""
 
 from __future__ import annotations
 
@@ -7,17 +7,19 @@ import json
 import sys
 from typing import Any
 
-from lynxplan.scenario import KIND_MODULES, kind_module, load_scenario
+from lynxplan.scenarios.registry import kind_module, kinds
 
 
 def register(subparsers: Any) -> None:
     """Add the ``schema`` and ``validate`` sub-commands."""
-    schema = subparsers.add_parser("schema", help="print the JSON Schema of a scenario kind")
+    schema = subparsers.add_parser(
+        "schema", help="print the JSON Schema of a scenario kind or of report.json"
+    )
     schema.add_argument(
         "kind",
         nargs="?",
         default="task",
-        help=f"scenario kind (default: task); one of {', '.join(sorted(KIND_MODULES))}",
+        help=f"'report', or a scenario kind (default: task): one of {', '.join(kinds())}",
     )
     schema.set_defaults(handler=handle_schema)
     validate = subparsers.add_parser("validate", help="check a scenario file without running it")
@@ -26,17 +28,23 @@ def register(subparsers: Any) -> None:
 
 
 def handle_schema(args: argparse.Namespace) -> int:
-    """Print the JSON Schema of ``args.kind``."""
-    module = kind_module(args.kind, "<command line>")
-    document = module.Scenario.model_json_schema(by_alias=True)
+    """Print the JSON Schema of ``args.kind`` (or of ``report.json``)."""
+    if args.kind == "report":
+        from lynxplan.scenarios.report import report_schema
+
+        document = report_schema()
+    else:
+        module = kind_module(args.kind, "<command line>")
+        document = module.Input.model_json_schema(by_alias=True)
     sys.stdout.write(json.dumps(document, indent=2) + "\n")
     return 0
 
 
 def handle_validate(args: argparse.Namespace) -> int:
     """Load and validate each file (ScenarioError -> the CLI prints it and exits 2)."""
+    from lynxplan.scenarios import load_scenario
+
     for path in args.scenario:
-        _, scenario = load_scenario(path)
-        kind = getattr(scenario, "kind", "?")
-        print(f"{path}: valid {kind} scenario")
+        loaded = load_scenario(path)
+        print(f"{path}: valid {loaded.scenario.kind} scenario")
     return 0

@@ -7,7 +7,6 @@ import math
 from pathlib import Path
 from typing import Any
 
-from lynxplan.runner import staged_outputs
 from lynxplan.units import LENGTH_UNITS
 
 
@@ -26,9 +25,10 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the workspace analysis with the command-line settings."""
-    from lynxplan.arm import workspace_scenario
     from lynxplan.exceptions import InputError
-    from lynxplan.scenario import Units
+    from lynxplan.scenarios import workspace as workspace_scenario
+    from lynxplan.scenarios.base import Units
+    from lynxplan.scenarios.outputs import staged_outputs
 
     if args.samples < 1:
         raise InputError(f"workspace --samples: must be at least 1. Got: {args.samples}")
@@ -36,7 +36,7 @@ def handle(args: argparse.Namespace) -> int:
         if not (math.isfinite(value) and value >= smallest):
             raise InputError(f"workspace {option}: must be at least {smallest} mm. Got: {value}")
     mm_to_unit = 1e-3 / LENGTH_UNITS[args.units]
-    scenario = workspace_scenario.Scenario(
+    scenario = workspace_scenario.Input(
         kind="workspace",
         samples=args.samples,
         cell=args.cell * mm_to_unit,
@@ -45,8 +45,9 @@ def handle(args: argparse.Namespace) -> int:
         units=Units(length=args.units, angle="deg"),
     )
     out = Path(args.out)
-    with staged_outputs(out) as staging:
-        outcome = workspace_scenario.run(scenario, staging)
+    with staged_outputs(out, force=getattr(args, "force", False)) as staging:
+        outcome = workspace_scenario.run(scenario)
+        workspace_scenario.write_outputs(scenario, outcome, staging, quick=False)
         summary = (staging / "workspace.json").read_text(encoding="utf-8")
     if args.json:
         print(summary, end="")

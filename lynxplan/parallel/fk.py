@@ -46,8 +46,15 @@ from lynxplan.exceptions import (
     NonFiniteInputError,
     ShapeError,
 )
+from lynxplan.parallel._legs import (
+    LegConstants,
+    anchor,
+    closure_value,
+    elbow_half_angle,
+    leg_offset,
+)
 from lynxplan.parallel.geometry import PLATFORM_PHASES, ParallelGeometry
-from lynxplan.parallel.ik import WORKING_MODES, elbows, kernel_constants
+from lynxplan.parallel.ik import WORKING_MODES, elbows, leg_constants
 
 _DEFAULT_GEOMETRY = ParallelGeometry()
 _SAMPLES = 16
@@ -83,53 +90,37 @@ def _as_thetas(theta: np.ndarray) -> np.ndarray:
     return array.reshape(-1, 3)
 
 
-def _anchors(elbow: np.ndarray, alpha: np.ndarray, rp: float) -> np.ndarray:
-    """``A_i(alpha) = E_i + rp u_i(alpha)``: elbow (N, 3, 2), alpha (N, K) -> (N, K, 3, 2)."""
-    phi = alpha[..., None] + np.array(PLATFORM_PHASES)
-    u = np.stack([np.cos(phi), np.sin(phi)], axis=-1)
-    return elbow[:, None] + rp * u
+@numba.njit(cache=True, nogil=True)
+def closure_kernel(
+    elbow: np.ndarray, alpha: np.ndarray, phase: np.ndarray, rp: float, el: float, out: np.ndarray
+) -> None:
+    """``f(alpha[n, k])`` for elbows (N, 3, 2) into ``out`` (N, K)."""
+    for n in range(alpha.shape[0]):
+        for k in range(alpha.shape[1]):
+            out[n, k] = closure_value(elbow[n], alpha[n, k], phase, rp, el)
 
 
 def closure_polynomial(
     elbow: np.ndarray, alpha: np.ndarray, distal: float, rp: float
 ) -> np.ndarray:
     """``f(alpha)`` of the module docstring for elbows (N, 3, 2) at angles (N, K) -> (N, K)."""
-    a = _anchors(elbow, alpha, rp)
-    m = 2.0 * (a[..., 1:, :] - a[..., :1, :])
-    b = np.sum(a[..., 1:, :] ** 2, axis=-1) - np.sum(a[..., :1, :] ** 2, axis=-1)
-    d = m[..., 0, 0] * m[..., 1, 1] - m[..., 0, 1] * m[..., 1, 0]
-    nx = b[..., 0] * m[..., 1, 1] - b[..., 1] * m[..., 0, 1]
-    ny = m[..., 0, 0] * b[..., 1] - m[..., 1, 0] * b[..., 0]
-    x = nx - a[..., 0, 0] * d
-    y = ny - a[..., 0, 1] * d
-    return np.asarray(x * x + y * y - distal**2 * d * d)
+    phases = np.array(PLATFORM_PHASES)
+    phase = np.stack([np.cos(phases), np.sin(phases)], axis=1)
+    angles = np.ascontiguousarray(np.asarray(alpha, dtype=float))
+    out = np.empty(angles.shape)
+    closure_kernel(np.ascontiguousarray(elbow, dtype=float), angles, phase, rp, distal, out)
+    return out
 
 
 @numba.njit(cache=True, nogil=True)
-def sextic_kernel(
-    elbow: np.ndarray, phase: np.ndarray, rp: float, el: float, out: np.ndarray
-) -> None:
+def sextic_kernel(elbow: np.ndarray, legs: LegConstants, out: np.ndarray) -> None:
     """Coefficients of ``z^3 f(z)`` (highest power first) for elbows (N, 3, 2) into ``out``
     (N, 7): the DFT of 16 samples of ``f`` (exact for a trigonometric polynomial of degree 3)."""
+    _, phase, rp, _, el = legs
     samples = np.empty(_SAMPLES)
-    ax = np.empty(3)
-    ay = np.empty(3)
     for n in range(elbow.shape[0]):
         for j in range(_SAMPLES):
-            alpha = 2.0 * math.pi * j / _SAMPLES
-            ca, sa = math.cos(alpha), math.sin(alpha)
-            for i in range(3):
-                ax[i] = elbow[n, i, 0] + rp * (ca * phase[i, 0] - sa * phase[i, 1])
-                ay[i] = elbow[n, i, 1] + rp * (sa * phase[i, 0] + ca * phase[i, 1])
-            m00, m01 = 2.0 * (ax[1] - ax[0]), 2.0 * (ay[1] - ay[0])
-            m10, m11 = 2.0 * (ax[2] - ax[0]), 2.0 * (ay[2] - ay[0])
-            a0 = ax[0] * ax[0] + ay[0] * ay[0]
-            b0 = ax[1] * ax[1] + ay[1] * ay[1] - a0
-            b1 = ax[2] * ax[2] + ay[2] * ay[2] - a0
-            d = m00 * m11 - m01 * m10
-            x = b0 * m11 - b1 * m01 - ax[0] * d
-            y = m00 * b1 - m10 * b0 - ay[0] * d
-            samples[j] = x * x + y * y - el * el * d * d
+            samples[j] = closure_value(elbow[n], 2.0 * math.pi * j / _SAMPLES, phase, rp, el)
         for k in range(-3, 4):
             acc = 0.0 + 0.0j
             for j in range(_SAMPLES):
@@ -140,11 +131,8 @@ def sextic_kernel(
 
 def sextic_coefficients(elbow: np.ndarray, geometry: ParallelGeometry) -> np.ndarray:
     """Coefficients of ``z^3 f(z)``, highest power first, shape (N, 7), from elbows (N, 3, 2)."""
-    _, phase = kernel_constants(geometry)
     out = np.empty((elbow.shape[0], 7), dtype=np.complex128)
-    sextic_kernel(
-        np.ascontiguousarray(elbow), phase, geometry.platform_circumradius, geometry.distal, out
-    )
+    sextic_kernel(np.ascontiguousarray(elbow), leg_constants(geometry), out)
     return out
 
 
@@ -154,22 +142,18 @@ def _wrap(angle: float) -> float:
 
 
 @numba.njit(cache=True, nogil=True)
-def _closure_newton(
-    elbow: np.ndarray, pose: np.ndarray, phase: np.ndarray, rp: float, el: float
-) -> None:
+def _closure_newton(elbow: np.ndarray, pose: np.ndarray, legs: LegConstants) -> None:
     """Polish ``pose`` (3,) in place on the closure equations |c - A_i(alpha)|^2 = L^2
     (Levenberg-damped Gauss-Newton steps, so a singular Jacobian at a Type II singularity does
     not blow up); scalar code, no allocation."""
+    _, phase, rp, _, el = legs
     for _ in range(_NEWTON_STEPS):
         ca, sa = math.cos(pose[2]), math.sin(pose[2])
         # Normal equations (J^T J + mu I) step = J^T g, accumulated row by row.
         n00 = n01 = n02 = n11 = n12 = n22 = 0.0
         r0 = r1 = r2 = 0.0
         for i in range(3):
-            cphi = ca * phase[i, 0] - sa * phase[i, 1]
-            sphi = sa * phase[i, 0] + ca * phase[i, 1]
-            rx = pose[0] - elbow[i, 0] - rp * cphi
-            ry = pose[1] - elbow[i, 1] - rp * sphi
+            rx, ry, cphi, sphi = leg_offset(pose[0], pose[1], ca, sa, phase, elbow, rp, i)
             g = rx * rx + ry * ry - el * el
             j0, j1, j2 = 2.0 * rx, 2.0 * ry, -2.0 * rp * (-rx * sphi + ry * cphi)
             n00 += j0 * j0
@@ -196,28 +180,17 @@ def _closure_newton(
 
 
 @numba.njit(cache=True, nogil=True)
-def _verify(
-    pose: np.ndarray,
-    theta: np.ndarray,
-    base: np.ndarray,
-    phase: np.ndarray,
-    rp: float,
-    s: float,
-    el: float,
-) -> tuple[float, int]:
+def _verify(pose: np.ndarray, theta: np.ndarray, legs: LegConstants) -> tuple[float, int]:
     """Largest |IK(pose) - theta| (wrapped) in the best-matching working mode, and that mode."""
+    base, phase, rp, s, el = legs
     worst, mode = 0.0, 0
     ca, sa = math.cos(pose[2]), math.sin(pose[2])
     for i in range(3):
-        cphi = ca * phase[i, 0] - sa * phase[i, 1]
-        sphi = sa * phase[i, 0] + ca * phase[i, 1]
-        dx = pose[0] - rp * cphi - base[i, 0]
-        dy = pose[1] - rp * sphi - base[i, 1]
+        dx, dy, _, _ = leg_offset(pose[0], pose[1], ca, sa, phase, base, rp, i)
         dist = math.sqrt(dx * dx + dy * dy)
         if dist == 0.0:
             return math.inf, 0
-        arg = min(1.0, max(-1.0, (s * s - el * el + dist * dist) / (2.0 * s * dist)))
-        half = math.acos(arg)
+        half = elbow_half_angle(dist, s, el)
         direction = math.atan2(dy, dx)
         plus = abs(_wrap(direction + half - theta[i]))
         minus = abs(_wrap(direction - half - theta[i]))
@@ -232,11 +205,7 @@ def fk_kernel(
     coefficients: np.ndarray,
     elbow: np.ndarray,
     theta: np.ndarray,
-    base: np.ndarray,
-    phase: np.ndarray,
-    rp: float,
-    s: float,
-    el: float,
+    legs: LegConstants,
     tolerances: np.ndarray,
     poses: np.ndarray,
     modes: np.ndarray,
@@ -248,6 +217,7 @@ def fk_kernel(
     -> centre from leg circles A and B -> Newton -> IK check -> dedupe -> sort by alpha.
     Writes ``poses`` (N, 6, 3), ``modes`` (N, 6), ``errors`` (N, 6), ``counts`` (N,);
     ``tolerances`` = (unit circle, IK verification, duplicate)."""
+    _, phase, rp, _, el = legs
     pose = np.empty(3)
     ax = np.empty(3)
     ay = np.empty(3)
@@ -276,8 +246,7 @@ def fk_kernel(
             alpha = math.atan2(z.imag, z.real)
             ca, sa = math.cos(alpha), math.sin(alpha)
             for i in range(3):
-                ax[i] = elbow[n, i, 0] + rp * (ca * phase[i, 0] - sa * phase[i, 1])
-                ay[i] = elbow[n, i, 1] + rp * (sa * phase[i, 0] + ca * phase[i, 1])
+                ax[i], ay[i] = anchor(elbow[n], ca, sa, phase, rp, i)
             # Centre: the intersection of leg circles A and B that lies closest to circle C.
             chx, chy = ax[1] - ax[0], ay[1] - ay[0]
             length = max(math.sqrt(chx * chx + chy * chy), 1e-300)
@@ -291,9 +260,9 @@ def fk_kernel(
                     best = miss
                     pose[0], pose[1] = cx, cy
             pose[2] = alpha
-            _closure_newton(elbow[n], pose, phase, rp, el)
+            _closure_newton(elbow[n], pose, legs)
             pose[2] = _wrap(pose[2])
-            error, mode = _verify(pose, theta[n], base, phase, rp, s, el)
+            error, mode = _verify(pose, theta[n], legs)
             if not error <= tolerances[1] or counts[n] >= 6:
                 continue
             duplicate = False
@@ -338,7 +307,6 @@ def solve_fk_batch(
     if np.any(degenerate):
         bad = thetas[int(np.argmax(degenerate))]
         raise DegenerateForwardKinematicsError((float(bad[0]), float(bad[1]), float(bad[2])))
-    base, phase = kernel_constants(geometry)
     count = thetas.shape[0]
     poses, modes = np.empty((count, 6, 3)), np.empty((count, 6), dtype=np.int64)
     errors, counts = np.empty((count, 6)), np.empty(count, dtype=np.int64)
@@ -353,11 +321,7 @@ def solve_fk_batch(
         np.ascontiguousarray(coefficients),
         np.ascontiguousarray(elbow),
         np.ascontiguousarray(thetas),
-        base,
-        phase,
-        geometry.platform_circumradius,
-        geometry.proximal,
-        geometry.distal,
+        leg_constants(geometry),
         tolerances,
         poses,
         modes,

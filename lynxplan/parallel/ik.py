@@ -24,6 +24,7 @@ from lynxplan.exceptions import (
     ShapeError,
     leg_unreachable_reason,
 )
+from lynxplan.parallel._legs import LegConstants, elbow_half_angle, leg_offset, mode_sign
 from lynxplan.parallel.geometry import LEG_NAMES, PLATFORM_PHASES, ParallelGeometry
 
 #: Working-mode labels in the report's order: sign of the acos term for legs A, B, C.
@@ -55,44 +56,43 @@ def kernel_constants(geometry: ParallelGeometry) -> tuple[np.ndarray, np.ndarray
     return geometry.base_joints, np.stack([np.cos(phases), np.sin(phases)], axis=1)
 
 
+def leg_constants(geometry: ParallelGeometry) -> LegConstants:
+    """The dimensions of ``geometry`` packed for the kernels."""
+    base, phase = kernel_constants(geometry)
+    return LegConstants(
+        np.ascontiguousarray(base, dtype=float),
+        phase,
+        float(geometry.platform_circumradius),
+        float(geometry.proximal),
+        float(geometry.distal),
+    )
+
+
 @numba.njit(cache=True, nogil=True)
-def ik_kernel(
-    poses: np.ndarray,
-    base: np.ndarray,
-    phase: np.ndarray,
-    rp: float,
-    s: float,
-    el: float,
-    out: np.ndarray,
-    distance: np.ndarray,
-) -> None:
+def ik_kernel(poses: np.ndarray, legs: LegConstants, out: np.ndarray, distance: np.ndarray) -> None:
     """Write the 8 working modes of ``poses`` (N, 3) into ``out`` (N, 8, 3), NaN where a leg does
     not reach; the leg distances |d_i| into ``distance`` (N, 3)."""
+    base, phase, rp, s, el = legs
     lo, hi = abs(s - el), s + el
     for k in range(poses.shape[0]):
         ca, sa = math.cos(poses[k, 2]), math.sin(poses[k, 2])
         for i in range(3):
-            cphi = ca * phase[i, 0] - sa * phase[i, 1]
-            sphi = sa * phase[i, 0] + ca * phase[i, 1]
-            dx = poses[k, 0] - rp * cphi - base[i, 0]
-            dy = poses[k, 1] - rp * sphi - base[i, 1]
+            dx, dy, _, _ = leg_offset(poses[k, 0], poses[k, 1], ca, sa, phase, base, rp, i)
             dist = math.sqrt(dx * dx + dy * dy)
             distance[k, i] = dist
             plus = math.nan
             minus = math.nan
-            if dist > 0.0:
-                arg = (s * s - el * el + dist * dist) / (2.0 * s * dist)
-                if (
-                    lo - dist <= ACOS_CLAMP_TOLERANCE * hi
-                    and dist - hi <= ACOS_CLAMP_TOLERANCE * hi
-                ):
-                    arg = min(1.0, max(-1.0, arg))
-                    base_angle = math.atan2(dy, dx)
-                    half = math.acos(arg)
-                    plus = base_angle + half
-                    minus = base_angle - half
+            if (
+                dist > 0.0
+                and lo - dist <= ACOS_CLAMP_TOLERANCE * hi
+                and dist - hi <= ACOS_CLAMP_TOLERANCE * hi
+            ):
+                base_angle = math.atan2(dy, dx)
+                half = elbow_half_angle(dist, s, el)
+                plus = base_angle + half
+                minus = base_angle - half
             for m in range(8):
-                out[k, m, i] = minus if (m >> (2 - i)) & 1 else plus
+                out[k, m, i] = minus if mode_sign(m, i) < 0.0 else plus
 
 
 class ParallelIKResult(NamedTuple):
@@ -138,19 +138,9 @@ def solve_ik_batch(
         geometry: Robot dimensions.
     """
     array = as_poses(poses)
-    base, phase = kernel_constants(geometry)
     out = np.empty((array.shape[0], 8, 3))
     distance = np.empty((array.shape[0], 3))
-    ik_kernel(
-        array,
-        base,
-        phase,
-        geometry.platform_circumradius,
-        geometry.proximal,
-        geometry.distal,
-        out,
-        distance,
-    )
+    ik_kernel(array, leg_constants(geometry), out, distance)
     reachable = ~np.isnan(out[:, 0, :])
     return ParallelIKResult(out, distance, reachable, geometry.leg_reach)
 

@@ -24,11 +24,18 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from lynxplan.parallel._legs import (
+    LegConstants,
+    det3,
+    elbow_half_angle,
+    jacobian_row,
+    leg_offset,
+    mode_sign,
+)
 from lynxplan.parallel.geometry import ParallelGeometry
 from lynxplan.parallel.ik import (
     as_poses,
-    elbows,
-    kernel_constants,
+    leg_constants,
     mode_index,
     platform_joints,
     solve_ik_batch,
@@ -46,21 +53,34 @@ class Jacobians(NamedTuple):
     """Diagonal of ``B``, shape (N, 3), in [m^2]."""
 
 
+@numba.njit(cache=True, nogil=True)
+def jacobian_kernel(
+    poses: np.ndarray,
+    theta: np.ndarray,
+    legs: LegConstants,
+    direct: np.ndarray,
+    inverse: np.ndarray,
+) -> None:
+    """``A`` (N, 3, 3) into ``direct`` and the diagonal of ``B`` (N, 3) into ``inverse`` at poses
+    (N, 3) with actuated angles ``theta`` (N, 3)."""
+    base, phase, rp, s, _ = legs
+    for k in range(poses.shape[0]):
+        ca, sa = math.cos(poses[k, 2]), math.sin(poses[k, 2])
+        for i in range(3):
+            dx, dy, cphi, sphi = leg_offset(poses[k, 0], poses[k, 1], ca, sa, phase, base, rp, i)
+            row = jacobian_row(dx, dy, cphi, sphi, theta[k, i], rp, s)
+            direct[k, i, 0], direct[k, i, 1], direct[k, i, 2], inverse[k, i] = row
+
+
 def jacobians(
     poses: np.ndarray, theta: np.ndarray, geometry: ParallelGeometry = _DEFAULT_GEOMETRY
 ) -> Jacobians:
     """Direct and inverse Jacobians of poses (N, 3) with actuated angles ``theta`` (N, 3)."""
     poses = as_poses(poses)
-    theta = np.asarray(theta, dtype=float).reshape(-1, 3)
-    joint = platform_joints(poses, geometry)
-    elbow = elbows(theta, geometry)
-    n = joint - elbow
-    arm = elbow - geometry.base_joints
-    lever = joint - poses[:, None, :2]
-    direct = np.concatenate(
-        [n, (lever[..., 0] * n[..., 1] - lever[..., 1] * n[..., 0])[..., None]], axis=-1
-    )
-    inverse = arm[..., 0] * n[..., 1] - arm[..., 1] * n[..., 0]
+    theta = np.ascontiguousarray(np.asarray(theta, dtype=float).reshape(-1, 3))
+    direct = np.empty((poses.shape[0], 3, 3))
+    inverse = np.empty((poses.shape[0], 3))
+    jacobian_kernel(poses, theta, leg_constants(geometry), direct, inverse)
     return Jacobians(direct, inverse)
 
 
@@ -90,19 +110,11 @@ def type1_index(
 
 @numba.njit(cache=True, nogil=True)
 def type2_grid_kernel(
-    x: np.ndarray,
-    y: np.ndarray,
-    alpha: float,
-    mode: int,
-    base: np.ndarray,
-    phase: np.ndarray,
-    rp: float,
-    s: float,
-    el: float,
-    out: np.ndarray,
+    x: np.ndarray, y: np.ndarray, alpha: float, mode: int, legs: LegConstants, out: np.ndarray
 ) -> None:
     """Type II index of working mode ``mode`` on the grid ``y`` (ny,) x ``x`` (nx,) at
     orientation ``alpha``, into ``out`` (ny, nx); NaN where a leg does not reach."""
+    base, phase, rp, s, el = legs
     lo, hi = abs(s - el), s + el
     ca, sa = math.cos(alpha), math.sin(alpha)
     scale = el * el * el * rp
@@ -111,32 +123,15 @@ def type2_grid_kernel(
         for j in range(x.shape[0]):
             ok = True
             for leg in range(3):
-                cphi = ca * phase[leg, 0] - sa * phase[leg, 1]
-                sphi = sa * phase[leg, 0] + ca * phase[leg, 1]
-                px = x[j] - rp * cphi
-                py = y[i] - rp * sphi
-                dx, dy = px - base[leg, 0], py - base[leg, 1]
+                dx, dy, cphi, sphi = leg_offset(x[j], y[i], ca, sa, phase, base, rp, leg)
                 dist = math.sqrt(dx * dx + dy * dy)
                 if dist < lo or dist > hi or dist == 0.0:
                     ok = False
                     break
-                arg = min(1.0, max(-1.0, (s * s - el * el + dist * dist) / (2.0 * s * dist)))
-                sign = -1.0 if (mode >> (2 - leg)) & 1 else 1.0
-                theta = math.atan2(dy, dx) + sign * math.acos(arg)
-                nx = px - base[leg, 0] - s * math.cos(theta)
-                ny = py - base[leg, 1] - s * math.sin(theta)
-                a[leg, 0] = nx
-                a[leg, 1] = ny
-                a[leg, 2] = -rp * cphi * ny + rp * sphi * nx
-            if not ok:
-                out[i, j] = math.nan
-                continue
-            det = (
-                a[0, 0] * (a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1])
-                - a[0, 1] * (a[1, 0] * a[2, 2] - a[1, 2] * a[2, 0])
-                + a[0, 2] * (a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0])
-            )
-            out[i, j] = det / scale
+                half = elbow_half_angle(dist, s, el)
+                theta = math.atan2(dy, dx) + mode_sign(mode, leg) * half
+                a[leg, 0], a[leg, 1], a[leg, 2], _ = jacobian_row(dx, dy, cphi, sphi, theta, rp, s)
+            out[i, j] = det3(a) / scale if ok else math.nan
 
 
 def type2_grid(
@@ -155,18 +150,13 @@ def type2_grid(
         mode: Working mode (index or label).
         geometry: Robot dimensions.
     """
-    base, phase = kernel_constants(geometry)
     out = np.empty((len(y), len(x)))
     type2_grid_kernel(
         np.ascontiguousarray(x, dtype=float),
         np.ascontiguousarray(y, dtype=float),
         float(alpha),
         mode_index(mode),
-        base,
-        phase,
-        geometry.platform_circumradius,
-        geometry.proximal,
-        geometry.distal,
+        leg_constants(geometry),
         out,
     )
     return out

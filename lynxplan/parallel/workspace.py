@@ -21,6 +21,7 @@ import numba
 import numpy as np
 
 from lynxplan.exceptions import InputError, NonFiniteInputError
+from lynxplan.parallel._legs import anchor
 from lynxplan.parallel.geometry import ParallelGeometry
 from lynxplan.parallel.ik import kernel_constants, mode_index
 from lynxplan.parallel.singular import type2_grid
@@ -54,8 +55,7 @@ def reach_kernel(
         oy = np.empty(3)
         for leg in range(3):
             # Leg reaches iff the centre is in the annulus about B_i + rp u_i(alpha).
-            ox[leg] = base[leg, 0] + rp * (ca * phase[leg, 0] - sa * phase[leg, 1])
-            oy[leg] = base[leg, 1] + rp * (sa * phase[leg, 0] + ca * phase[leg, 1])
+            ox[leg], oy[leg] = anchor(base, ca, sa, phase, rp, leg)
             for j in range(nx):
                 dx2[leg, j] = (x[j] - ox[leg]) ** 2
         for i in range(y.shape[0]):

@@ -1,5 +1,4 @@
-"""Arm task scenarios (kind ``task``): schema, resolution, run, report, plots and HTML."""
+"""Arm tasks (the scenario kind ``task``): resolution into a plan, the run, report, plots, HTML.
 
-from lynxplan.task.expect import Comparison, parse_comparison
-
-__all__ = ["Comparison", "parse_comparison"]
+The input model and the kind's entry points are in :mod:`lynxplan.scenarios.task`.
+"""

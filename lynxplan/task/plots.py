@@ -11,12 +11,12 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from lynxplan.task.expect import parse_comparison
 from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
+    from lynxplan.scenarios.expect import ParsedExpectation
+    from lynxplan.scenarios.task import Scenario
     from lynxplan.task.run import TaskResult
-    from lynxplan.task.schema import Scenario
 
 MOTION_COLOURS = {"line": "tab:red", "free": "tab:blue"}
 OBSTACLE_COLOUR = "tab:orange"
@@ -180,8 +180,14 @@ def plot_joints(scenario: Scenario, result: TaskResult, path: Path) -> Path:
     return path
 
 
-def plot_clearance(scenario: Scenario, result: TaskResult, path: Path) -> Path | None:
-    """Clearance to each obstacle vs time (exact distances at 100 Hz, minimum marked)."""
+def plot_clearance(
+    scenario: Scenario,
+    result: TaskResult,
+    path: Path,
+    required: ParsedExpectation | None = None,
+) -> Path | None:
+    """Clearance to each obstacle vs time: exact distances (coal, minimum over the arm's
+    primitives) at 100 Hz, the overall minimum marked, the required clearance as a line."""
     if not result.setup.obstacles:
         return None
     import matplotlib
@@ -208,10 +214,9 @@ def plot_clearance(scenario: Scenario, result: TaskResult, path: Path) -> Path |
         ms=7,
         label=f"minimum {best.clearance / scale:.4g} {unit} ({best.geometry})",
     )
-    if scenario.expect.min_clearance is not None:
-        threshold = parse_comparison(scenario.expect.min_clearance, "length", unit, ">=")
+    if required is not None:
         ax.axhline(
-            threshold.value / scale, color="k", ls="--", lw=1, label=f"expected {threshold.text}"
+            required.value / scale, color="k", ls="--", lw=1, label=f"required {required.text}"
         )
     _shade_lines(ax, result)
     ax.set_xlabel("time [s]")
@@ -226,12 +231,17 @@ def plot_clearance(scenario: Scenario, result: TaskResult, path: Path) -> Path |
     return path
 
 
-def write_plots(scenario: Scenario, result: TaskResult, out_dir: Path) -> list[Path]:
-    """Write every figure into ``out_dir``; returns the files written."""
+def write_plots(
+    scenario: Scenario,
+    result: TaskResult,
+    out_dir: Path,
+    required_clearance: ParsedExpectation | None = None,
+) -> list[str]:
+    """Write every figure into ``out_dir``; returns the names of the files written."""
     written = [
         plot_task_view(scenario, result, "side", out_dir / "task_side.png"),
         plot_task_view(scenario, result, "top", out_dir / "task_top.png"),
         plot_joints(scenario, result, out_dir / "joints.png"),
     ]
-    clearance = plot_clearance(scenario, result, out_dir / "clearance.png")
-    return written + ([clearance] if clearance is not None else [])
+    clearance = plot_clearance(scenario, result, out_dir / "clearance.png", required_clearance)
+    return [p.name for p in written + ([clearance] if clearance is not None else [])]

@@ -1,26 +1,22 @@
-"""Task results -> expectations checked, ``report.json`` and the stdout summary.
+"""Task results -> metrics, the ``details`` of ``report.json`` and the stdout summary.
 
-report.json keys are stable and every value is in SI units (m, rad, s) with the unit in the key
-(``duration_s``, ``clearance_m``, ``value_rad_s``); ``units`` states them once more.
+Detail keys are stable and every value is in SI units (m, rad, s) with the unit in the key
+(``duration_s``, ``clearance_m``, ``value_rad_s``).
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING, Any, NamedTuple
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lynxplan.constants import COAL_GJK_TOLERANCE, FCL_DISTANCE_TOLERANCE
-from lynxplan.task.expect import parse_comparison
 from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
+    from lynxplan.scenarios.task import Scenario
     from lynxplan.task.run import TaskResult
-    from lynxplan.task.schema import Scenario
-
-#: Version of the report.json layout (bumped when a key changes meaning or disappears).
-REPORT_VERSION = 1
 
 ACCURACY_STATEMENT = (
     "Clearances are exact distances between the URDF collision primitives (boxes, cylinders) and "
@@ -34,110 +30,36 @@ ACCURACY_STATEMENT = (
 )
 
 
-class ExpectationOutcome(NamedTuple):
-    """One ``expect:`` entry checked."""
-
-    key: str
-    """The expectation key, e.g. ``"min_clearance"``."""
-    expected: str
-    """The expectation as written."""
-    measured: Any
-    """The measured value (SI units) or flag."""
-    holds: bool
-    """Whether it holds."""
-    message: str
-    """A line for the failure list (or the success note)."""
-
-
-def _measured(result: TaskResult) -> dict[str, Any]:
+def task_metrics(result: TaskResult) -> dict[str, Any]:
+    """The task kind's metrics, SI units (see :mod:`lynxplan.scenarios.task`)."""
     lines = [r.max_line_deviation for r in result.segments if r.max_line_deviation is not None]
     return {
         "collision_free": result.collision.collision_free,
         "within_limits": result.within_limits,
         "min_clearance": result.collision.min_clearance.clearance,
-        "max_duration": result.setup.plan.duration,
-        "max_path_deviation": max(lines, default=0.0),
-        "max_joint_speed": max((r.max_joint_speed for r in result.segments), default=0.0),
-        "contacts": float(len(result.collision.contacts)),
+        "duration": result.setup.plan.duration,
+        "path_deviation": max(lines, default=0.0),
+        "joint_speed": max((r.max_joint_speed for r in result.segments), default=0.0),
+        "contacts": len(result.collision.contacts),
     }
 
 
-_QUANTITY = {
-    "min_clearance": ("length", ">="),
-    "max_duration": ("time", "<="),
-    "max_path_deviation": ("length", "<="),
-    "max_joint_speed": ("angular_speed", "<="),
-    "contacts": ("count", "<="),
-}
-
-
-def _display(value: float, quantity: str, scenario: Scenario) -> str:
-    if quantity == "length":
-        length = scenario.units.length
-        return f"{value / length_factor(length):.6g} {length}"
-    if quantity == "angular_speed":
-        angle = scenario.units.angle
-        return f"{value / angle_factor(angle):.6g} {angle}/s"
-    if quantity == "time":
-        return f"{value:.6g} s"
-    return f"{value:g}"
-
-
-def evaluate(scenario: Scenario, result: TaskResult) -> list[ExpectationOutcome]:
-    """Check every ``expect:`` entry of ``scenario`` against ``result``."""
-    measured = _measured(result)
-    outcomes = []
-    for key, expected in scenario.expect.model_dump(exclude_none=True).items():
-        value = measured[key]
-        if isinstance(expected, bool):
-            holds = bool(value) == expected
-            outcomes.append(
-                ExpectationOutcome(
-                    key,
-                    str(expected).lower(),
-                    value,
-                    holds,
-                    f"{key}: expected {expected}, "
-                    f"measured {bool(value)}" + ("" if holds else _why(key, result)),
-                )
-            )
-            continue
-        quantity, default_op = _QUANTITY[key]
-        unit = {
-            "length": scenario.units.length,
-            "angular_speed": f"{scenario.units.angle}/s",
-            "time": "s",
-            "count": "",
-        }[quantity]
-        comparison = parse_comparison(expected, quantity, unit, default_op)
-        holds = comparison.holds(value)
-        expected_text = f"{comparison.op} {_display(comparison.value, quantity, scenario)}"
-        outcomes.append(
-            ExpectationOutcome(
-                key,
-                str(expected),
-                value,
-                holds,
-                f"{key}: measured {_display(value, quantity, scenario)}, expected {expected_text}",
-            )
+def task_notes(result: TaskResult) -> dict[str, str]:
+    """Explanations of the collision and limit metrics (for failed expectations)."""
+    notes = {}
+    contacts = result.collision.contacts
+    if contacts:
+        c = contacts[0]
+        notes["collision_free"] = (
+            f"{len(contacts)} contact(s); first: {c.link} ({c.geometry}) hits {c.obstacle} "
+            f"at t = {c.time:.3f} s, depth {c.penetration_depth * 1e3:.3f} mm"
         )
-    return outcomes
-
-
-def _why(key: str, result: TaskResult) -> str:
-    if key == "collision_free":
-        contacts = result.collision.contacts
-        if contacts:
-            c = contacts[0]
-            return (
-                f" ({len(contacts)} contact(s); first: {c.link} ({c.geometry}) hits {c.obstacle} "
-                f"at t = {c.time:.3f} s, depth {c.penetration_depth * 1e3:.3f} mm)"
-            )
-        return " (some sample interval could not be certified)"
-    if key == "within_limits":
-        bad = [i for i, check in enumerate(result.limits) if not check.within_limits]
-        return f" (segments {bad} leave their limits)"
-    return ""
+    elif not result.collision.collision_free:
+        notes["collision_free"] = "some sample interval could not be certified"
+    bad = [i for i, check in enumerate(result.limits) if not check.within_limits]
+    if bad:
+        notes["within_limits"] = f"segments {bad} leave their limits"
+    return notes
 
 
 def _record(record: Any) -> dict[str, Any]:
@@ -248,18 +170,13 @@ def _obstacle_entry(obstacle: Any) -> dict[str, Any]:
     return entry
 
 
-def report_json(
-    scenario: Scenario, result: TaskResult, outcomes: list[ExpectationOutcome]
-) -> dict[str, Any]:
-    """The report.json document (JSON-ready: floats, lists, strings; no NaN)."""
+def task_details(scenario: Scenario, result: TaskResult) -> dict[str, Any]:
+    """The ``details`` of report.json (JSON-ready: floats, lists, strings; no NaN)."""
     setup, collision, samples = result.setup, result.collision, result.samples
     segments = result.segments
     lines = [r.max_line_deviation for r in segments if r.max_line_deviation is not None]
     fastest = max(segments, key=lambda r: r.max_joint_speed)
     data = {
-        "report_version": REPORT_VERSION,
-        "kind": "task",
-        "name": scenario.name,
         "description": scenario.description,
         "units": {
             "length": "m",
@@ -315,24 +232,9 @@ def report_json(
             "accuracy": ACCURACY_STATEMENT,
         },
         "timing_comparison": _comparison(result),
-        "expectations": [
-            {
-                "key": o.key,
-                "expected": o.expected,
-                "measured": _jsonable(o.measured),
-                "holds": o.holds,
-            }
-            for o in outcomes
-        ],
         "stage_seconds": result.stage_seconds,
     }
     return _clean(data)
-
-
-def _jsonable(value: Any) -> Any:
-    if isinstance(value, (bool, np.bool_)):
-        return bool(value)
-    return _finite(float(value))
 
 
 def _clean(value: Any) -> Any:
@@ -348,7 +250,7 @@ def _clean(value: Any) -> Any:
     return value
 
 
-def summary(scenario: Scenario, result: TaskResult, outcomes: list[ExpectationOutcome]) -> str:
+def summary(scenario: Scenario, result: TaskResult) -> str:
     """One paragraph for stdout, lengths and speeds in the scenario's units."""
     setup, collision = result.setup, result.collision
     unit, angle = scenario.units.length, scenario.units.angle
@@ -388,11 +290,4 @@ def summary(scenario: Scenario, result: TaskResult, outcomes: list[ExpectationOu
     if result.comparison is not None:
         totals = ", ".join(f"{k} {v:.3f} s" for k, v in result.comparison.total_duration.items())
         text += f" Durations: {totals} (ruckig: free segments only)."
-    failed = sum(1 for o in outcomes if not o.holds)
-    if outcomes:
-        text += (
-            f" {len(outcomes) - failed} of {len(outcomes)} expectations hold."
-            if failed
-            else f" All {len(outcomes)} expectations hold."
-        )
     return text

@@ -1,27 +1,25 @@
-"""Scenario kind ``task``: plan, collision and limit checks, retiming comparison, report, outputs.
+"""A resolved task sampled, checked against its joint limits and obstacles, and retimed.
 
-``run`` is what ``lynxplan run scenarios/ok_task.yaml --out DIR`` calls. It writes
-``report.json`` (always), ``task_side.png``, ``task_top.png``, ``joints.png``, ``clearance.png``
-and ``<file stem of the name>.html`` (unless quick or switched off in ``outputs``).
+:func:`execute` is the computation behind the scenario kind ``task``
+(:mod:`lynxplan.scenarios.task`); it writes no file.
 """
 
 from __future__ import annotations
 
-import json
 import re
 import time
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lynxplan.constants import LIMIT_CHECK_RELATIVE_TOLERANCE, LIMIT_SNAP_TOLERANCE
-from lynxplan.scenario import Outcome
-from lynxplan.task.schema import Scenario
 from lynxplan.task.setup import TaskSetup, resolve
 
-__all__ = ["LimitCheck", "Scenario", "TaskResult", "execute", "run"]
+if TYPE_CHECKING:
+    from lynxplan.scenarios.task import Scenario
+
+__all__ = ["LimitCheck", "TaskResult", "execute", "html_name"]
 
 
 @dataclass(frozen=True)
@@ -148,37 +146,7 @@ def execute(scenario: Scenario, setup: TaskSetup | None = None, progress: Any = 
     return TaskResult(setup, samples, segments, checks, collision, world, comparison, seconds)
 
 
-def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Outcome:
-    """Run a task scenario; write report.json (and plots, HTML unless quick) into ``out_dir``."""
-    from lynxplan.progress import progress_bar
-    from lynxplan.task.report import evaluate, report_json, summary
-
-    setup = scenario._setup or resolve(scenario)
-    with progress_bar(f"task {scenario.name or ''}".strip()) as progress:
-        result = execute(scenario, setup, progress)
-        outcomes = evaluate(scenario, result)
-        if out_dir is not None:
-            data = report_json(scenario, result, outcomes)
-            (out_dir / "report.json").write_text(json.dumps(data, indent=2) + "\n")
-            if not quick:
-                _write_visuals(scenario, result, out_dir)
-        progress(5, 5)
-    failed = tuple(o.message for o in outcomes if not o.holds)
-    return Outcome(summary(scenario, result, outcomes), failed)
-
-
 def html_name(scenario: Scenario) -> str:
     """File name of the HTML export: the scenario name as a slug, e.g. ``ok_task.html``."""
     slug = re.sub(r"[^a-z0-9]+", "_", scenario.name.lower()).strip("_")
     return f"{slug or 'task'}.html"
-
-
-def _write_visuals(scenario: Scenario, result: TaskResult, out_dir: Path) -> None:
-    if scenario.outputs.plots:
-        from lynxplan.task.plots import write_plots
-
-        write_plots(scenario, result, out_dir)
-    if scenario.outputs.html:
-        from lynxplan.task.html import write_html
-
-        write_html(scenario, result, out_dir / html_name(scenario))

@@ -1,8 +1,8 @@
 """A validated task scenario resolved into SI values: robot, obstacles, waypoint angles, the plan.
 
-Every problem found here is raised as a pydantic ``ValidationError`` located at its key path
-(``segments[3].to``, ``waypoints.O2.pose``), so the scenario loader reports it exactly like a
-schema error: file, key path, reason.
+Every problem found here is raised as a :class:`~lynxplan.exceptions.ScenarioValueError` located
+at its key path (``segments[3].to``, ``waypoints.O2.pose``); the scenario runner reports it like a
+schema error: file, key path (line), reason. This runs at run time, never during validation.
 """
 
 from __future__ import annotations
@@ -11,20 +11,18 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
-from pydantic import ValidationError
-from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
-from lynxplan.exceptions import LynxplanError
+from lynxplan.exceptions import LynxplanError, ScenarioValueError
 from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm
     from lynxplan.collision.obstacles import Obstacle
-    from lynxplan.task.schema import (
+    from lynxplan.scenarios.base import RobotRef
+    from lynxplan.scenarios.task import (
         BoxEntry,
         CylinderEntry,
-        RobotEntry,
         Scenario,
         SphereEntry,
         WaypointEntry,
@@ -77,24 +75,16 @@ class TaskSetup:
     writing_plane: WritingPlane | None
 
 
-class _InvalidError(Exception):
-    """A resolution problem at a key path (converted to a ValidationError)."""
-
-    def __init__(self, loc: tuple[str | int, ...], message: str, value: Any = None) -> None:
-        super().__init__(message)
-        self.loc, self.message, self.value = loc, message, value
+_InvalidError = ScenarioValueError
 
 
 def resolve(scenario: Scenario) -> TaskSetup:
-    """Resolve a schema-valid scenario; ValidationError (with the key path) if it cannot be."""
-    try:
-        return _resolve(scenario)
-    except _InvalidError as problem:
-        error = PydanticCustomError("task_scenario", problem.message.replace("{", "{{"))
-        raise ValidationError.from_exception_data(
-            "task scenario",
-            [InitErrorDetails(type=error, loc=problem.loc, input=problem.value)],
-        ) from problem
+    """Resolve a valid scenario into SI values, solving waypoint IK and planning the segments.
+
+    Raises:
+        ScenarioValueError: naming the key path of the value that cannot be used.
+    """
+    return _resolve(scenario)
 
 
 def _resolve(scenario: Scenario) -> TaskSetup:
@@ -109,10 +99,10 @@ def _resolve(scenario: Scenario) -> TaskSetup:
         name: _waypoint(name, entry, arm, length, angle)
         for name, entry in scenario.waypoints.items()
     }
-    route = _route(scenario)
-    q = waypoints[route[0][0]]
+    path = route(scenario)
+    q = waypoints[path[0][0]]
     segments = []
-    for i, ((_, target), entry) in enumerate(zip(route, scenario.segments, strict=True)):
+    for i, ((_, target), entry) in enumerate(zip(path, scenario.segments, strict=True)):
         segment = _segment(i, entry, waypoints[target], q, scenario, limits)
         segments.append(segment)
         q = segment.q_end
@@ -122,15 +112,19 @@ def _resolve(scenario: Scenario) -> TaskSetup:
         plane = WritingPlane(
             np.array(wp.point) * length, float(wp.tilt) * angle, np.array(wp.size) * length
         )
-    return TaskSetup(arm, obstacles, waypoints, route, limits, Plan(tuple(segments), limits), plane)
+    return TaskSetup(arm, obstacles, waypoints, path, limits, Plan(tuple(segments), limits), plane)
 
 
-def load_robot(entry: RobotEntry) -> Arm:
-    """The arm of the scenario; _InvalidError naming the key when it is not usable for a task."""
+def load_robot(entry: RobotRef) -> Arm:
+    """The arm of the scenario; ScenarioValueError naming the key when it is not usable."""
     from lynxplan.arm.model import load_arm
 
-    if entry.example_robot_data is not None:
-        _reject_example_robot(entry.example_robot_data)
+    if entry.name not in (None, "al5"):
+        raise _InvalidError(
+            ("robot", "name"),
+            f"robot {entry.name!r}: task scenarios plan with the AL5's analytic IK; valid: al5",
+            entry.name,
+        )
     try:
         return load_arm(entry.urdf)
     except LynxplanError as exc:
@@ -139,27 +133,6 @@ def load_robot(entry: RobotEntry) -> Arm:
             f"{exc}; task scenarios plan with the AL5's analytic IK and need its joint structure",
             entry.urdf,
         ) from exc
-
-
-def _reject_example_robot(name: str) -> None:
-    """Load an example-robot-data robot to name it in the message, then reject it."""
-    try:
-        import example_robot_data
-
-        robot = example_robot_data.load(name)
-    except Exception as exc:  # the loader raises ValueError, ImportError, RuntimeError...
-        known = ", ".join(sorted(getattr(example_robot_data, "ROBOTS", {}))[:40])
-        detail = f"; known names: {known}" if known else ""
-        raise _InvalidError(
-            ("robot", "example_robot_data"), f"cannot load {name!r}: {exc}{detail}", name
-        ) from exc
-    raise _InvalidError(
-        ("robot", "example_robot_data"),
-        f"{name!r} loaded ({robot.model.nq} joints), but task scenarios plan with the AL5's "
-        "analytic IK and need its 5-joint structure; use this robot with lynxplan.viz and "
-        "lynxplan.collision directly",
-        name,
-    )
 
 
 def _limits(scenario: Scenario, arm: Arm, angle: float) -> MotionLimits:
@@ -288,7 +261,7 @@ def _check_within_limits(q: np.ndarray, arm: Arm, loc: tuple[str | int, ...], an
             )
 
 
-def _route(scenario: Scenario) -> tuple[tuple[str, str], ...]:
+def route(scenario: Scenario) -> tuple[tuple[str, str], ...]:
     names = list(scenario.waypoints)
     valid = ", ".join(names)
     route: list[tuple[str, str]] = []

@@ -164,8 +164,9 @@ class LineSegment:
         """Geometric joint path at increasing ``s`` (m,) in [0, 1]; shape (m, 5) in [rad]."""
         return self.solve(s, self.q_start)[0]
 
-    def path_derivatives(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """``dq/ds`` and ``d2q/ds2`` at ``s`` (m,) from the grid, each (m, 5), in [rad].
+    def path_derivatives(self, s: np.ndarray | float) -> tuple[np.ndarray, np.ndarray]:
+        """``dq/ds`` and ``d2q/ds2`` at ``s`` (m,) from the grid, each (m, 5), in [rad]
+        (a scalar ``s`` gives shape (5,)).
 
         ``dq/ds`` is a cubic Hermite interpolant (its slopes are the grid's ``d2q/ds2``);
         ``d2q/ds2`` is interpolated linearly.
@@ -174,7 +175,7 @@ class LineSegment:
         s = np.clip(np.asarray(s, dtype=float), 0.0, 1.0)
         h = g.s[1] - g.s[0]
         i = np.minimum((s / h).astype(np.int64), g.s.size - 2)
-        u = ((s - g.s[i]) / h)[:, None]
+        u = ((s - g.s[i]) / h)[..., None]
         f0, f1, m0, m1 = g.dq_ds[i], g.dq_ds[i + 1], g.d2q_ds2[i], g.d2q_ds2[i + 1]
         first = (
             (2 * u**3 - 3 * u**2 + 1) * f0

@@ -16,11 +16,13 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from typing import NamedTuple
+from typing import NamedTuple, TypeVar
 
 import numpy as np
 
 from lynxplan.exceptions import TimingError
+
+_Time = TypeVar("_Time", float, np.ndarray)
 
 
 class LspbState(NamedTuple):
@@ -104,20 +106,54 @@ def lspb(
     a0_arr, da_arr = np.asarray(a0, dtype=float), np.asarray(da, dtype=float)
     first = time <= tau
     last = time >= big_t - tau
-    start = time + tau
-    end = time - big_t + tau
-    # Report eqs.: the three pieces of the law (SPEC Part 2).
-    s = np.where(first, start**2 / (4 * big_t * tau), time / big_t)
-    s = np.where(last, time / big_t - end**2 / (4 * big_t * tau), s)
-    sd = np.where(first, start / (2 * big_t * tau), 1.0 / big_t)
-    sd = np.where(last, 1.0 / big_t - end / (2 * big_t * tau), sd)
-    sdd = np.where(first, 1.0 / (2 * big_t * tau), 0.0)
-    sdd = np.where(last, -1.0 / (2 * big_t * tau), sdd)
+    blend_in = _first_blend(time, big_t, tau)
+    cruise = _cruise(time, big_t)
+    blend_out = _last_blend(time, big_t, tau)
+    s, sd, sdd = (
+        np.where(last, blend_out[k], np.where(first, blend_in[k], cruise[k])) for k in range(3)
+    )
     # At rest outside the segment: velocity and acceleration are zero there.
     outside = (np.asarray(t) < -tau) | (np.asarray(t) > big_t + tau)
     sd = np.where(outside, 0.0, sd)
     sdd = np.where(outside, 0.0, sdd)
     return LspbState(a0_arr + da_arr * s, da_arr * sd, da_arr * sdd)
+
+
+# Report eqs.: the three pieces of the normalised law (SPEC Part 2), at report time ``time``;
+# each returns (s, ds/dt, d2s/dt2) for floats or arrays.
+def _first_blend(time: _Time, big_t: float, tau: float) -> tuple[_Time, _Time, float]:
+    start = time + tau
+    return start**2 / (4 * big_t * tau), start / (2 * big_t * tau), 1.0 / (2 * big_t * tau)
+
+
+def _cruise(time: _Time, big_t: float) -> tuple[_Time, float, float]:
+    return time / big_t, 1.0 / big_t, 0.0
+
+
+def _last_blend(time: _Time, big_t: float, tau: float) -> tuple[_Time, _Time, float]:
+    end = time - big_t + tau
+    return (
+        time / big_t - end**2 / (4 * big_t * tau),
+        1.0 / big_t - end / (2 * big_t * tau),
+        -1.0 / (2 * big_t * tau),
+    )
+
+
+def unit_lspb_scalar(t: float, timing: LspbTiming) -> tuple[float, float, float]:
+    """:func:`unit_lspb` at one time since the start ``t`` in [s], in plain floats (for
+    per-sample loops): ``(s, ds/dt [1/s], d2s/dt2 [1/s^2])``."""
+    tau, big_t = timing.tau, timing.cruise_parameter
+    report_time = t - tau
+    time = min(max(report_time, -tau), big_t + tau)
+    if time >= big_t - tau:
+        s, sd, sdd = _last_blend(time, big_t, tau)
+    elif time <= tau:
+        s, sd, sdd = _first_blend(time, big_t, tau)
+    else:
+        s, sd, sdd = _cruise(time, big_t)
+    if report_time < -tau or report_time > big_t + tau:
+        return s, 0.0, 0.0
+    return s, sd, sdd
 
 
 def lspb_since_start(

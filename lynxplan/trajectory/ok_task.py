@@ -2,11 +2,16 @@
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import Plan, SegmentSpec, build_plan
+
+if TYPE_CHECKING:
+    from lynxplan.collision.obstacles import BoxObstacle
 
 #: Waypoint names, joint angles in [deg] and the motion to the next waypoint (SPEC Part 3).
 OK_TASK_WAYPOINTS: tuple[tuple[str, tuple[float, float, float, float, float], str], ...] = (
@@ -26,6 +31,12 @@ OK_TASK_WAYPOINTS: tuple[tuple[str, tuple[float, float, float, float, float], st
     ("I", (0, 0, 0, 0, 0), ""),
 )
 
+#: The report's two walls (SPEC Part 3): name, minimum corner and size, each (3,), in [in].
+OK_TASK_WALLS: tuple[tuple[str, tuple[float, float, float], tuple[float, float, float]], ...] = (
+    ("wall_letters", (-0.2, 8, -2), (0.4, 10, 3.5)),
+    ("wall_home", (5, 4.5, -2), (10, 1, 8)),
+)
+
 #: The report's timing of every segment: tt = 2 s, ta = 0.5 s (26 s in all).
 REPORT_TIMING = LspbTiming(2.0, 0.5)
 
@@ -33,6 +44,17 @@ REPORT_TIMING = LspbTiming(2.0, 0.5)
 def ok_task_configurations() -> np.ndarray:
     """The 14 waypoints' joint angles, shape (14, 5), in [rad]."""
     return np.radians(np.array([row[1] for row in OK_TASK_WAYPOINTS], dtype=float))
+
+
+def ok_task_walls() -> list[BoxObstacle]:
+    """The two walls as axis-aligned boxes, in [m]."""
+    from lynxplan.collision.obstacles import axis_aligned_box
+    from lynxplan.units import INCH
+
+    return [
+        axis_aligned_box(name, np.array(corner) * INCH, np.array(size) * INCH)
+        for name, corner, size in OK_TASK_WALLS
+    ]
 
 
 def ok_task_specs(

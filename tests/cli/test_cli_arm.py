@@ -71,7 +71,7 @@ def test_ik_without_all_lists_only_solutions_within_limits(capsys) -> None:
         (("workspace", "--voxel", "1e-9"), "--voxel: must be at least 0.1 mm"),
         (
             ("workspace", "--samples", "100", "--out", "/dev/null/x"),
-            "cannot create output folder /dev/null/x: File exists",
+            r"output folder /dev/null/x: cannot be created \(File exists\)",
         ),
         (("bench", "--section", "nope"), "invalid choice: 'nope'"),
     ],

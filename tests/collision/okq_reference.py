@@ -4,22 +4,15 @@ from __future__ import annotations
 
 import numpy as np
 
-from lynxplan.collision import axis_aligned_box
-from lynxplan.trajectory.ok_task import ok_task_configurations
-from lynxplan.units import INCH
+from lynxplan.trajectory.ok_task import ok_task_configurations, ok_task_walls
 
 #: SPEC Part 3 waypoints, shape (14, 5), in [deg] (the package's table, not a copy).
 WAYPOINTS_DEG = np.degrees(ok_task_configurations())
 
 
 def spec_obstacles() -> list:
-    """The two walls of SPEC Part 3 (inches there), in [m]."""
-    return [
-        axis_aligned_box(
-            "wall_letters", np.array([-0.2, 8, -2]) * INCH, np.array([0.4, 10, 3.5]) * INCH
-        ),
-        axis_aligned_box("wall_home", np.array([5, 4.5, -2]) * INCH, np.array([10, 1, 8]) * INCH),
-    ]
+    """The two walls of SPEC Part 3 (inches there), in [m] (the package's table)."""
+    return ok_task_walls()
 
 
 def joint_space_task(rate: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -15,7 +15,7 @@ from lynxplan.parallel.fk import solve_fk
 from lynxplan.parallel.geometry import pose_from_mm_deg
 from lynxplan.parallel.ik import WORKING_MODES, solve_ik
 from lynxplan.parallel.workspace import constant_orientation_workspace
-from lynxplan.runner import run_scenario
+from lynxplan.scenarios import run_scenario
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 
@@ -166,8 +166,8 @@ def test_scenario_expectation_failures(tmp_path: Path) -> None:
     (tmp_path / "ik.yaml").write_text(text)
     outcome = run_scenario(tmp_path / "ik.yaml", None)
     assert outcome.failed_expectations == (
-        "expect.solutions[0] (+++): got [58.003017, 159.740405, -64.423082], expected "
-        "[58.1, 159.7404, -64.4231] within 0.0001",
+        "solutions[0]: measured [ 58.003017, 159.740405, -64.423082] deg, expected "
+        "[ 58.1   , 159.7404, -64.4231] deg within 0.0001 deg",
     )
     text = (
         (SCENARIOS / "parallel_workspace.yaml")
@@ -177,7 +177,7 @@ def test_scenario_expectation_failures(tmp_path: Path) -> None:
     (tmp_path / "ws.yaml").write_text(text)
     outcome = run_scenario(tmp_path / "ws.yaml", None)
     assert outcome.failed_expectations == (
-        "alpha -10: area 63121 outside expected [50000.0, 60000.0]",
+        "max_area: measured [58406., 63121.] mm^2, expected 60000",
     )
 
 

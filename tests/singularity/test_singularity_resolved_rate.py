@@ -14,7 +14,8 @@ from lynxplan.exceptions import (
     SingularityParameterError,
     TaskError,
 )
-from lynxplan.scenario import load_scenario
+from lynxplan.scenarios import load_scenario
+from lynxplan.scenarios.singularity import build_problem
 from lynxplan.singularity.measures import manipulability, task_jacobian
 from lynxplan.singularity.resolved_rate import (
     PathReference,
@@ -29,7 +30,6 @@ from lynxplan.singularity.resolved_rate import (
     run_reference,
     run_resolved_rate,
 )
-from lynxplan.singularity.scenario import build_problem
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "singularity_line.yaml"
 #: numba kernel (closed form) vs Python reference (Pinocchio): same arithmetic up to rounding,
@@ -39,7 +39,7 @@ KERNEL_VS_REFERENCE_ATOL = 1e-9
 
 @pytest.fixture(scope="module")
 def problem() -> ResolvedRateProblem:
-    _, scenario = load_scenario(SCENARIO)
+    scenario = load_scenario(SCENARIO).scenario
     return build_problem(scenario)  # type: ignore[arg-type]
 
 

@@ -8,8 +8,7 @@ from pathlib import Path
 import pytest
 
 from lynxplan.exceptions import ScenarioError
-from lynxplan.runner import run_scenario
-from lynxplan.scenario import load_scenario
+from lynxplan.scenarios import load_scenario, run_scenario
 
 SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "singularity_line.yaml"
 
@@ -18,10 +17,10 @@ def test_shipped_scenario_runs_and_meets_expectations(tmp_path: Path) -> None:
     outcome = run_scenario(SCENARIO, tmp_path / "out", quick=True)
     assert outcome.ok, outcome.failed_expectations
     report = json.loads((tmp_path / "out" / "report.json").read_text())
-    assert set(report["metrics"]) == {"pinv", "speed_limit", "dls", "tr"}
-    assert report["metrics"]["pinv"]["speed_limit_exceeded"] is True
-    assert report["line_distance_to_base_axis_m"] == pytest.approx(1e-3, abs=1e-12)
-    assert "tool_on_base_axis" in report["singular_conditions"]
+    assert set(report["details"]["metrics"]) == {"pinv", "speed_limit", "dls", "tr"}
+    assert report["details"]["metrics"]["pinv"]["speed_limit_exceeded"] is True
+    assert report["details"]["line_distance_to_base_axis_m"] == pytest.approx(1e-3, abs=1e-12)
+    assert "tool_on_base_axis" in report["details"]["singular_conditions"]
     assert "pinv" in outcome.summary
 
 
@@ -33,7 +32,7 @@ def test_failed_expectation_is_reported(tmp_path: Path) -> None:
     path.write_text(text)
     outcome = run_scenario(path, None, quick=True)
     assert outcome.failed_expectations == (
-        "max_distance_to_singularity: the line passes 1 mm from the base axis, more than 0.5 mm",
+        "max_distance_to_singularity: measured 1 mm, expected 0.5",
     )
 
 

@@ -7,7 +7,7 @@ from pathlib import Path
 import pytest
 from browser import CHROMIUM, neutral, orange, path_blue, path_red, screenshot
 
-from lynxplan.runner import run_scenario
+from lynxplan.scenarios import run_scenario
 
 OK_TASK = Path(__file__).resolve().parents[2] / "scenarios" / "ok_task.yaml"
 WIDTH, HEIGHT = 1000, 700

@@ -12,9 +12,9 @@ from task_fixtures import scenario_dict, write_scenario
 from lynxplan.cli import main
 from lynxplan.collision import clearance_profile
 from lynxplan.exceptions import ScenarioError
-from lynxplan.runner import run_scenario
-from lynxplan.scenario import load_scenario
+from lynxplan.scenarios import load_scenario, run_scenario
 from lynxplan.task.run import execute
+from lynxplan.task.setup import resolve
 from lynxplan.units import INCH
 
 OK_TASK = Path(__file__).resolve().parents[2] / "scenarios" / "ok_task.yaml"
@@ -32,7 +32,7 @@ def ok_run(tmp_path_factory):
 def test_ok_task_expectations_hold(ok_run):
     outcome, report, _ = ok_run
     assert outcome.ok, outcome.failed_expectations
-    assert [e["key"] for e in report["expectations"]] == [
+    assert [e["name"] for e in report["expectations"]] == [
         "collision_free",
         "within_limits",
         "min_clearance",
@@ -45,7 +45,7 @@ def test_ok_task_expectations_hold(ok_run):
 
 def test_ok_task_report_segments(ok_run):
     _, report, _ = ok_run
-    segments = report["segments"]
+    segments = report["details"]["segments"]
     assert [(s["from"], s["to"], s["motion"]) for s in segments] == [
         ("O1", "O2", "line"),
         ("O2", "O3", "line"),
@@ -66,25 +66,25 @@ def test_ok_task_report_segments(ok_run):
         assert set(s) >= {"min_clearance", "within_limits", "path_deviation_m", "peak_joint_speed"}
         assert (s["path_deviation_m"] is None) == (s["motion"] == "free")
         assert s["min_clearance"]["obstacle"] in ("wall_letters", "wall_home")
-    totals = report["totals"]
+    totals = report["details"]["totals"]
     assert totals["duration_s"] == pytest.approx(26.0, abs=1e-12)
     assert totals["min_clearance"]["clearance_m"] == min(
         s["min_clearance"]["clearance_m"] for s in segments
     )
-    assert report["sample_count"] == 26001
-    assert report["collision_check"]["checked_pairs"] == 16  # 8 primitives x 2 obstacles
-    assert "coal" in report["collision_check"]["accuracy"]
-    table = report["timing_comparison"]
+    assert report["details"]["sample_count"] == 26001
+    assert report["details"]["collision_check"]["checked_pairs"] == 16  # 8 primitives x 2 obstacles
+    assert "coal" in report["details"]["collision_check"]["accuracy"]
+    table = report["details"]["timing_comparison"]
     assert table["totals"]["lspb"]["total_duration_s"] == pytest.approx(26.0, abs=1e-9)
     assert table["totals"]["ruckig"]["segments_covered"] == 6  # the free segments
-    assert report["units"]["length"] == "m"
+    assert report["details"]["units"]["length"] == "m"
 
 
 def test_reported_minimum_is_the_exact_distance_and_a_true_minimum(ok_run):
     _, report, _ = ok_run
-    _, scenario = load_scenario(OK_TASK)
-    result = execute(scenario, scenario._setup)
-    best = report["totals"]["min_clearance"]
+    scenario = load_scenario(OK_TASK).scenario
+    result = execute(scenario, resolve(scenario))
+    best = report["details"]["totals"]["min_clearance"]
     samples = result.samples
     k = int(np.argmin(np.abs(samples.t - best["time_s"])))
     obstacle = [o.name for o in result.setup.obstacles].index(best["obstacle"])
@@ -101,7 +101,7 @@ def test_reported_minimum_is_the_exact_distance_and_a_true_minimum(ok_run):
 def test_cli_run_exit_codes(tmp_path, capsys):
     small = write_scenario(tmp_path / "small.yaml", scenario_dict(compare=False))
     assert main(["run", str(small), "--out", str(tmp_path / "a"), "--quick"]) == 0
-    assert "All 2 expectations hold" in capsys.readouterr().out
+    assert "expectations: 2 of 2 hold" in capsys.readouterr().out
     strict = scenario_dict(compare=False, expect={"min_clearance": ">= 10 in", "contacts": "== 1"})
     failing = write_scenario(tmp_path / "failing.yaml", strict)
     assert main(["run", str(failing), "--out", str(tmp_path / "b"), "--quick"]) == 1
@@ -110,14 +110,14 @@ def test_cli_run_exit_codes(tmp_path, capsys):
     assert "min_clearance: measured" in out and "expected >= 10 in" in out
     assert "contacts: measured 0, expected == 1" in out
     report = json.loads((tmp_path / "b" / "report.json").read_text())
-    assert [e["holds"] for e in report["expectations"]] == [False, False]
+    assert [e["passed"] for e in report["expectations"]] == [False, False]
 
 
 def test_collision_is_reported_with_link_obstacle_and_time(tmp_path):
     # A ball on the free path from K4 to I3 (its midpoint pen position).
     data = scenario_dict(compare=False, expect={"collision_free": True})
-    _, scenario = load_scenario(write_scenario(tmp_path / "s.yaml", data))
-    result = execute(scenario, scenario._setup)
+    scenario = load_scenario(write_scenario(tmp_path / "s.yaml", data)).scenario
+    result = execute(scenario, resolve(scenario))
     middle = result.samples.tool[np.argmin(np.abs(result.samples.t - 3.0)), :3, 3] / INCH
     data["obstacles"] = [
         {"name": "ball", "type": "sphere", "centre": middle.tolist(), "radius": 0.5}
@@ -147,7 +147,11 @@ def test_failed_run_leaves_earlier_outputs_intact(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="disk full"):
         run_scenario(changed, out, quick=False)
     assert (out / "report.json").read_text() == before
-    assert sorted(p.name for p in out.iterdir()) == ["report.json"]
+    assert sorted(p.name for p in out.iterdir()) == [
+        ".lynxplan-output",
+        "report.json",
+        "trajectory.csv",
+    ]
     assert not [p for p in tmp_path.iterdir() if "staging" in p.name]
 
 
@@ -158,12 +162,14 @@ def test_full_run_writes_plots_and_html(tmp_path):
     assert outcome.ok
     names = sorted(p.name for p in out.iterdir())
     assert names == [
+        ".lynxplan-output",
         "clearance.png",
         "joints.png",
         "report.json",
         "small.html",
         "task_side.png",
         "task_top.png",
+        "trajectory.csv",
     ]
     for png in out.glob("*.png"):
         assert png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"

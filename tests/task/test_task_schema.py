@@ -10,8 +10,9 @@ import pytest
 from task_fixtures import BASE, scenario_dict, write_scenario
 
 from lynxplan.cli import main
-from lynxplan.exceptions import ScenarioError
-from lynxplan.scenario import load_scenario
+from lynxplan.exceptions import ScenarioError, ScenarioValueError
+from lynxplan.scenarios import load_scenario
+from lynxplan.task.setup import resolve
 from lynxplan.units import INCH
 
 # The report's T_O2 (SPEC Part 3, inches) and its joint angles in degrees.
@@ -26,12 +27,18 @@ PRINTED_POSE_ANGLE_TOLERANCE = 0.02
 
 
 def _load(tmp_path, data):
-    return load_scenario(write_scenario(tmp_path / "s.yaml", data))
+    """Validate, then resolve (robot, obstacles, waypoint IK, plan) as a run does first."""
+    loaded = load_scenario(write_scenario(tmp_path / "s.yaml", data))
+    try:
+        resolve(loaded.scenario)
+    except ScenarioValueError as exc:
+        raise loaded.located(exc) from exc
+    return loaded.scenario
 
 
 def test_base_scenario_is_valid(tmp_path):
-    _, scenario = _load(tmp_path, BASE)
-    setup = scenario._setup
+    scenario = _load(tmp_path, BASE)
+    setup = resolve(scenario)
     assert setup.route == (("K3", "K4"), ("K4", "I3"))
     np.testing.assert_allclose(setup.waypoints["K4"], np.radians([79, 70, -77, 29, 0]), atol=1e-15)
     box = setup.obstacles[0]
@@ -53,12 +60,13 @@ def test_base_scenario_is_valid(tmp_path):
         ({"expect": {"min_clearance": ">= 0.2 ft"}}, r"expect\.min_clearance", "unknown unit 'ft'"),
         ({"expect": {"min_clearance": "about 3"}}, r"expect\.min_clearance", "not a comparison"),
         ({"expect": {"max_duration": "<= 3 in"}}, r"expect\.max_duration", "unknown unit 'in'"),
-        ({"expect": {"collision_free": "maybe"}}, r"expect\.collision_free", "valid boolean"),
+        ({"expect": {"collision_free": "maybe"}}, r"expect\.collision_free", "true or false"),
+        ({"expect": {"colour": "red"}}, r"expect\.colour", "unknown expectation 'colour'"),
         ({"robot": {"urdf": "/nonexistent.urdf"}}, r"robot\.urdf", "URDF file not found"),
     ],
 )
 def test_schema_errors_name_file_key_and_reason(tmp_path, change, location, reason):
-    with pytest.raises(ScenarioError, match=rf"s\.yaml, {location}: .*{reason}"):
+    with pytest.raises(ScenarioError, match=rf"s\.yaml, {location}( \(line \d+\))?: .*{reason}"):
         _load(tmp_path, scenario_dict(**change))
 
 
@@ -114,7 +122,7 @@ def _with_waypoint(name, entry):
     ],
 )
 def test_reference_and_reachability_errors(tmp_path, data, location, reason):
-    with pytest.raises(ScenarioError, match=rf"s\.yaml, {location}: .*{reason}"):
+    with pytest.raises(ScenarioError, match=rf"s\.yaml, {location}( \(line \d+\))?: .*{reason}"):
         _load(tmp_path, data)
 
 
@@ -154,26 +162,24 @@ def test_line_leaving_the_reach_is_located_at_its_segment(tmp_path):
         _load(tmp_path, data)
 
 
-def test_example_robot_data_robot_is_loaded_then_rejected(tmp_path):
-    with pytest.raises(ScenarioError, match=r"robot\.example_robot_data: .*AL5's analytic IK"):
-        _load(tmp_path, scenario_dict(robot={"example_robot_data": "double_pendulum"}))
-    with pytest.raises(ScenarioError, match=r"robot\.example_robot_data: cannot load 'no_such"):
-        _load(tmp_path, scenario_dict(robot={"example_robot_data": "no_such_robot"}))
+def test_robot_other_than_al5_is_rejected_at_run_time(tmp_path):
+    with pytest.raises(ScenarioError, match=r"robot\.name: .*AL5's analytic IK"):
+        _load(tmp_path, scenario_dict(robot={"name": "so101"}))
 
 
 def test_pose_and_approach_waypoints_are_solved_by_ik(tmp_path):
     data = _with_waypoint("K4", {"pose": T_O2})
-    _, scenario = _load(tmp_path, data)
+    scenario = _load(tmp_path, data)
     np.testing.assert_allclose(
-        np.degrees(scenario._setup.waypoints["K4"]), Q_O2_DEG, atol=PRINTED_POSE_ANGLE_TOLERANCE
+        np.degrees(resolve(scenario).waypoints["K4"]), Q_O2_DEG, atol=PRINTED_POSE_ANGLE_TOLERANCE
     )
     # Position + approach of O2's pen (5-D target): q5 is free and taken from q_reference (0).
     data = _with_waypoint(
         "K4", {"position": [row[3] for row in T_O2], "approach": [row[2] for row in T_O2]}
     )
-    _, scenario = _load(tmp_path, data)
+    scenario = _load(tmp_path, data)
     np.testing.assert_allclose(
-        np.degrees(scenario._setup.waypoints["K4"]), Q_O2_DEG, atol=PRINTED_POSE_ANGLE_TOLERANCE
+        np.degrees(resolve(scenario).waypoints["K4"]), Q_O2_DEG, atol=PRINTED_POSE_ANGLE_TOLERANCE
     )
 
 
@@ -196,8 +202,8 @@ def test_oriented_obstacles(tmp_path):
             "axis": [1, 0, 0],
         },
     ]
-    _, scenario = _load(tmp_path, scenario_dict(obstacles=obstacles))
-    box, ball, post = scenario._setup.obstacles
+    scenario = _load(tmp_path, scenario_dict(obstacles=obstacles))
+    box, ball, post = resolve(scenario).obstacles
     # yaw 90 deg maps the box's x axis onto +y.
     np.testing.assert_allclose(box.rotation[:, 0], [0, 1, 0], atol=1e-15)
     assert ball.radius == pytest.approx(1 * INCH, abs=1e-15)

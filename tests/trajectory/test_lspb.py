@@ -8,7 +8,13 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from lynxplan.exceptions import TimingError
-from lynxplan.trajectory.lspb import LspbTiming, lspb, lspb_since_start, unit_lspb
+from lynxplan.trajectory.lspb import (
+    LspbTiming,
+    lspb,
+    lspb_since_start,
+    unit_lspb,
+    unit_lspb_scalar,
+)
 
 ATOL = 1e-9
 
@@ -129,3 +135,10 @@ def test_invalid_timings_are_clear_errors(tt: float, ta: float, match: str) -> N
         LspbTiming(tt, ta)
     assert info.value.tt == tt or np.isnan(tt)
     assert info.value.ta == ta
+
+
+@settings(max_examples=60, deadline=None)
+@given(timings(), st.floats(-1.0, 12.0))
+def test_scalar_law_equals_the_vectorised_law(timing: LspbTiming, t: float) -> None:
+    vectorised = unit_lspb(t, timing)
+    np.testing.assert_allclose(unit_lspb_scalar(t, timing), [float(v) for v in vectorised], atol=ATOL)

@@ -9,7 +9,7 @@ import pytest
 
 from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.exceptions import RetimingError
-from lynxplan.scenario import load_scenario
+from lynxplan.scenarios import load_scenario
 from lynxplan.trajectory import (
     LspbTiming,
     MotionLimits,
@@ -119,8 +119,9 @@ def test_toppra_is_within_the_limits_on_the_ok_task_and_shipped_scenarios() -> N
     ratios = _toppra_ratios(plan.segments, plan.limits, 1000.0)
     assert {s.kind for s in plan.segments} == {"free", "line"}
     for name in ("free_motion.yaml", "straight_line.yaml"):
-        module, scenario = load_scenario(SCENARIOS / name)
-        built = module.build(scenario)  # type: ignore[attr-defined]
+        loaded = load_scenario(SCENARIOS / name)
+        scenario = loaded.scenario
+        built = loaded.kind.build(scenario)  # type: ignore[attr-defined]
         ratios += _toppra_ratios(built.segments, built.limits, scenario.sample_rate)  # type: ignore[attr-defined]
     peaks = np.array(ratios)
     assert np.all(peaks[:, :2] <= TOPPRA_SLACK), peaks

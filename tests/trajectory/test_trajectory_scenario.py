@@ -9,7 +9,7 @@ import pytest
 
 from lynxplan.cli import main
 from lynxplan.exceptions import PathNotFollowableError, ScenarioError
-from lynxplan.runner import run_scenario
+from lynxplan.scenarios import run_scenario
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
 SHIPPED = ["free_motion.yaml", "straight_line.yaml"]
@@ -20,16 +20,18 @@ def test_shipped_scenarios_run_and_hold_their_expectations(name: str, tmp_path: 
     outcome = run_scenario(SCENARIOS / name, tmp_path, quick=True)
     assert outcome.ok, outcome.failed_expectations
     report = json.loads((tmp_path / "report.json").read_text())
-    segment = report["segments"][0]
+    segment = report["details"]["segments"][0]
     assert segment["tt"] == 3.0 and segment["ta"] == 1.0
     assert segment["limit_violation_samples"] == 0
     assert {"lspb", "lspb_auto", "toppra"} <= set(segment["comparison"])
-    assert report["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
+    assert report["details"]["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
 
 
 def test_free_motion_report_matches_the_lspb_formulas(tmp_path: Path) -> None:
     run_scenario(SCENARIOS / "free_motion.yaml", tmp_path, quick=True)
-    stats = json.loads((tmp_path / "report.json").read_text())["segments"][0]["comparison"]
+    stats = json.loads((tmp_path / "report.json").read_text())["details"]["segments"][0][
+        "comparison"
+    ]
     # dA / T with T = tt - ta = 2 s and dA / (T ta) for the report's example.
     delta = [1.2, 0.9, 0.68, 1.0, 0.0]
     assert stats["lspb"]["peak_velocity_rad_s"] == pytest.approx([d / 2 for d in delta], abs=1e-9)
@@ -129,8 +131,9 @@ def test_configurations_outside_the_joint_limits_are_rejected(tmp_path: Path) ->
 
 def test_unreachable_target_names_the_segment(tmp_path: Path) -> None:
     body = "segments: [{motion: line, to_pose: [[1, 0, 0, 5], [0, -1, 0, 0], [0, 0, -1, 0]]}]\n"
-    with pytest.raises(PathNotFollowableError, match=r"segment 0 \(line\) leaves the arm's reach"):
+    with pytest.raises(ScenarioError, match=r"segment 0 \(line\) leaves the arm's reach") as info:
         run_scenario(_write(tmp_path, body), None)
+    assert isinstance(info.value.__cause__, PathNotFollowableError)
 
 
 def test_cli_runs_a_scenario_and_reports_bad_input(tmp_path: Path, capsys) -> None:
@@ -140,4 +143,4 @@ def test_cli_runs_a_scenario_and_reports_bad_input(tmp_path: Path, capsys) -> No
     assert "trajectory free motion" in capsys.readouterr().out
     bad = _write(tmp_path, "segments: [{motion: free, to_q: [0, 0, 0, 0, 0], tt: -1, ta: 0.5}]")
     assert main(["run", str(bad), "--out", str(tmp_path / "x")]) == 2
-    assert "tt must be positive" in capsys.readouterr().err
+    assert "segments[0].tt: Input should be greater than 0 (line 3)" in capsys.readouterr().err

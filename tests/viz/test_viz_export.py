@@ -65,6 +65,15 @@ def test_tilted_plane_rises_along_y():
     assert WritingPlane(np.zeros(3), np.array([0.0, 0, 1])).size == (0.3, 0.3)
 
 
+def test_tilted_plane_axes_are_x_then_the_rising_direction():
+    tilt = np.radians(20.0)
+    c, s = np.cos(tilt), np.sin(tilt)
+    plane = WritingPlane.tilted([0.0, 0.2, 0.0], tilt, (0.25, 0.2))
+    expected = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    np.testing.assert_allclose(plane.rotation, expected, atol=1e-15)
+    assert plane.size == (0.25, 0.2)
+
+
 def test_export_errors(arm, tmp_path):
     q, t = np.zeros((3, 5)), np.array([0.0, 1.0, 2.0])
     out = tmp_path / "x.html"

@@ -1,21 +1,30 @@
 """Scenario kind ``singularity``: the four resolved-rate strategies side by side on one path.
 
-Writes ``report.json`` (parameters, singular conditions of the task, the metrics table) and, unless
-``quick``, the plots of :mod:`lynxplan.singularity.plots`.
+Metrics: ``pinv_exceeds_speed_limit``, ``within_speed_limits`` and ``returns_to_path`` (flags per
+strategy: pinv, speed_limit, dls, tr), ``distance_to_singularity`` [m] (closest approach of the
+line to the base axis). ``report.json`` details hold the parameters, the singular conditions of
+the task and the metrics table; unless quick, the plots of :mod:`lynxplan.singularity.plots`.
 """
 
 from __future__ import annotations
 
-import json
 import math
 from pathlib import Path
-from typing import Literal
+from typing import Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, model_validator
 
 from lynxplan.arm import Arm, load_arm
-from lynxplan.scenario import Outcome, StrictModel, Units
+from lynxplan.scenarios.base import (
+    SI_UNITS,
+    KindOutput,
+    Quantity,
+    ScenarioModel,
+    StrictModel,
+    Units,
+    scaled,
+)
 from lynxplan.singularity.measures import (
     make_task,
     max_manipulability,
@@ -34,6 +43,8 @@ from lynxplan.singularity.resolved_rate import (
     run_metrics,
 )
 from lynxplan.units import angle_factor, length_factor
+
+NAME = "singularity"
 
 StrategyName = Literal["pinv", "speed_limit", "dls", "tr"]
 
@@ -88,22 +99,17 @@ class DlsSettings(StrictModel):
     lambda_min: float = Field(1e-4, gt=0, description="Damping everywhere (5x5 regular).")
 
 
-class Expect(StrictModel):
-    """Expectations checked after the run."""
-
-    pinv_exceeds_speed_limit: bool | None = None
-    within_speed_limits: tuple[StrategyName, ...] = ()
-    returns_to_path: tuple[StrategyName, ...] = ()
-    max_distance_to_singularity: float | None = Field(
-        None, gt=0, description="The reference passes this close to the singular set (length)."
-    )
-
-
-class Scenario(StrictModel):
+class Input(ScenarioModel):
     """A singularity scenario: one path, four strategies."""
 
+    metrics: ClassVar[dict[str, Quantity]] = {
+        "pinv_exceeds_speed_limit": "bool",
+        "within_speed_limits": "flags",
+        "returns_to_path": "flags",
+        "distance_to_singularity": "length",
+    }
+
     kind: Literal["singularity"]
-    description: str = ""
     units: Units = Units()
     task: Literal["position", "position_pitch"] = "position_pitch"
     line: Line
@@ -114,7 +120,22 @@ class Scenario(StrictModel):
     control: Control = Control()
     tr: TrSettings
     dls: DlsSettings = DlsSettings()
-    expect: Expect = Expect()
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs in [m] and [rad]."""
+        length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
+        data = super().si_inputs()
+        data["units"] = dict(SI_UNITS)
+        data["line"].update(
+            start=scaled(self.line.start, length),
+            end=scaled(self.line.end, length),
+            pitch=scaled(self.line.pitch, angle),
+        )
+        data["q_reference"] = scaled(self.q_reference, angle)
+        return data
+
+
+Scenario = Input
 
 
 def build_problem(scenario: Scenario) -> ResolvedRateProblem:
@@ -176,64 +197,35 @@ def line_distance_to_base_axis(start: np.ndarray, end: np.ndarray) -> float:
     return float(np.linalg.norm(a + s * direction))
 
 
-def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Outcome:
-    """Run the four strategies, write report.json (and plots unless quick), check expectations."""
+def run(scenario: Input) -> KindOutput:
+    """Run the four strategies on the scenario's path (no files)."""
     problem = build_problem(scenario)
     arm = load_arm()
     runs = run_all(problem)
     metrics = {s: run_metrics(r, problem, arm.limits) for s, r in runs.items()}
-    lf = length_factor(scenario.units.length)
     path_points = problem.path.points
     axis_distance = line_distance_to_base_axis(path_points[0, :3], path_points[-1, :3])
     conditions = [c.value for c in singular_conditions(problem.task, arm.geometry)]
-    failures = check_expectations(
-        scenario.expect, metrics, axis_distance, lf, scenario.units.length
-    )
-    if out_dir is not None:
-        write_report(out_dir, scenario, problem, runs, metrics, axis_distance, conditions)
-        if not quick:
-            from lynxplan.singularity.plots import plot_runs
-
-            plot_runs(runs, problem, out_dir)
-    text = summary(problem, metrics, axis_distance, conditions)
-    return Outcome(summary=text, failed_expectations=failures)
-
-
-def check_expectations(
-    expect: Expect,
-    metrics: dict[Strategy, RunMetrics],
-    axis_distance: float,
-    lf: float,
-    unit: str = "m",
-) -> tuple[str, ...]:
-    """Human-readable failed expectations; ``lf`` metres per ``unit`` (the file's length unit)."""
     by_name = {m.strategy: m for m in metrics.values()}
-    failures = []
-    if expect.pinv_exceeds_speed_limit is not None:
-        exceeded = by_name["pinv"].speed_limit_exceeded
-        if exceeded != expect.pinv_exceeds_speed_limit:
-            failures.append(
-                f"pinv_exceeds_speed_limit: expected {expect.pinv_exceeds_speed_limit}, peak "
-                f"speed ratio {by_name['pinv'].peak_speed_ratio:.3g}"
-            )
-    for name in expect.within_speed_limits:
-        if by_name[name].speed_limit_exceeded:
-            failures.append(
-                f"within_speed_limits: {name} peaks at {by_name[name].peak_speed_ratio:.3g} x "
-                "its speed limit"
-            )
-    for name in expect.returns_to_path:
-        if by_name[name].completion_time is None:
-            failures.append(f"returns_to_path: {name} never gets back within tolerance of the end")
-    if expect.max_distance_to_singularity is not None:
-        limit = expect.max_distance_to_singularity * lf
-        if axis_distance > limit:
-            failures.append(
-                f"max_distance_to_singularity: the line passes {axis_distance / lf:.6g} "
-                f"{unit} from the base axis, more than "
-                f"{expect.max_distance_to_singularity:.6g} {unit}"
-            )
-    return tuple(failures)
+    values = {
+        "pinv_exceeds_speed_limit": by_name["pinv"].speed_limit_exceeded,
+        "within_speed_limits": {n: not m.speed_limit_exceeded for n, m in by_name.items()},
+        "returns_to_path": {n: m.completion_time is not None for n, m in by_name.items()},
+        "distance_to_singularity": axis_distance,
+    }
+    text = summary(problem, metrics, axis_distance, conditions)
+    details = report_details(scenario, problem, runs, metrics, axis_distance, conditions)
+    return KindOutput(values, text, details, payload=(runs, problem))
+
+
+def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
+    """Unless quick, the plots of :mod:`lynxplan.singularity.plots`."""
+    if quick:
+        return []
+    from lynxplan.singularity.plots import plot_runs
+
+    runs, problem = output.payload
+    return [str(Path(p).relative_to(out_dir)) for p in plot_runs(runs, problem, out_dir)]
 
 
 def summary(
@@ -261,20 +253,17 @@ def summary(
     return "\n".join(lines)
 
 
-def write_report(
-    out_dir: Path,
-    scenario: Scenario,
+def report_details(
+    scenario: Input,
     problem: ResolvedRateProblem,
     runs: dict[Strategy, ResolvedRateRun],
     metrics: dict[Strategy, RunMetrics],
     axis_distance: float,
     conditions: list[str],
-) -> None:
-    """report.json: parameters, the start configuration and its singular distances, metrics."""
-    out_dir.mkdir(parents=True, exist_ok=True)
+) -> dict[str, Any]:
+    """Parameters, the start configuration and its singular distances, the metrics table."""
     q0 = problem.q0
-    report = {
-        "kind": "singularity",
+    return {
         "description": scenario.description,
         "task": {"name": problem.task.name, "rows": list(problem.task.row_names)},
         "singular_conditions": conditions,
@@ -297,4 +286,3 @@ def write_report(
         "metrics": {STRATEGY_NAMES[s]: m._asdict() for s, m in metrics.items()},
         "steps": {STRATEGY_NAMES[s]: int(r.t.size) for s, r in runs.items()},
     }
-    (out_dir / "report.json").write_text(json.dumps(report, indent=2) + "\n", encoding="utf-8")

@@ -13,19 +13,19 @@ Example (``scenarios/free_motion.yaml``)::
         tt: 3.0                           # [s]; omit tt and ta for the shortest LSPB
         ta: 1.0
     plot: {segment: 0, joint: 2}          # the report's q2(t) figure: segment index, joint 1..5
-    expect: {max_line_deviation: 1.0e-9, joint_limits_respected: true}
+    expect: {max_line_deviation: "<= 1e-9 m", joint_limits_respected: true}
 
-Velocity limits come from the URDF. Outputs: ``report.json`` (per-segment figures and the
-comparison table) and, unless quick, ``joint_profiles.png``, ``tool_xyz.png`` and
-``durations.png``.
+Velocity limits come from the URDF. Metrics: ``line_deviation`` [m] (largest tool-point distance
+from the lines), ``joint_limits_respected``, ``branch_switches`` (IK branch changes along lines),
+``duration`` [s]. Artifacts: ``trajectory.csv`` (t, q, qd, qdd and the tool point x, y, z, SI)
+and, unless quick, ``joint_profiles.png``, ``tool_xyz.png`` and ``durations.png``; the per-segment
+figures and the comparison table are in ``report.json`` details.
 """
 
 from __future__ import annotations
 
-import json
-import math
 from pathlib import Path
-from typing import Any, Literal
+from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
 from pydantic import Field, ValidationError, model_validator
@@ -34,7 +34,16 @@ from pydantic_core import InitErrorDetails, PydanticCustomError
 from lynxplan.arm.geometry import JointLimits
 from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
-from lynxplan.scenario import Outcome, StrictModel, Units
+from lynxplan.scenarios.base import (
+    SI_UNITS,
+    KindOutput,
+    Quantity,
+    ScenarioModel,
+    StrictModel,
+    Units,
+    scale_translation,
+    scaled,
+)
 from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import (
@@ -49,17 +58,22 @@ from lynxplan.trajectory.plan import (
 from lynxplan.trajectory.retime import TOPPRA_LIMIT_SAFETY
 from lynxplan.units import angle_factor, length_factor
 
-PerJoint = float | list[float]
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+#: A per-joint limit: one value for every joint, or one value per joint (5).
+PerJoint = Positive | Annotated[list[Positive], Field(min_length=5, max_length=5)]
+
+NAME = "trajectory"
 
 
 class SegmentEntry(StrictModel):
     """One segment of the scenario."""
 
     motion: Literal["free", "line"] = Field(description="Joint-space or Cartesian straight line.")
-    to_q: list[float] | None = Field(default=None, min_length=5, max_length=5)
-    to_pose: list[list[float]] | None = Field(default=None, min_length=3, max_length=4)
-    tt: float | None = Field(default=None, description="Total time, in [s].")
-    ta: float | None = Field(default=None, description="Blend time, in [s].")
+    to_q: list[Finite] | None = Field(default=None, min_length=5, max_length=5)
+    to_pose: list[list[Finite]] | None = Field(default=None, min_length=3, max_length=4)
+    tt: Positive | None = Field(default=None, le=3600.0, description="Total time, in [s].")
+    ta: Positive | None = Field(default=None, description="Blend time, in [s].")
     orientation: Literal["consistent", "slerp", "lerp", "drive"] = "consistent"
 
     @model_validator(mode="after")
@@ -115,32 +129,40 @@ class PlotEntry(StrictModel):
     joint: int = Field(default=2, ge=1, le=5, description="1-based joint number (q2 default).")
 
 
-class Expect(StrictModel):
-    """Expected results (all optional)."""
-
-    max_line_deviation: float | None = Field(
-        default=None, gt=0, description="Largest tool-point deviation from lines, in [m]."
-    )
-    joint_limits_respected: bool | None = None
-    max_branch_switches: int | None = Field(default=None, ge=0)
-
-
-class Scenario(StrictModel):
+class Input(ScenarioModel):
     """A ``trajectory`` scenario."""
 
+    metrics: ClassVar[dict[str, Quantity]] = {
+        "line_deviation": "length",
+        "joint_limits_respected": "bool",
+        "branch_switches": "count",
+        "duration": "time",
+    }
+
     kind: Literal["trajectory"]
-    name: str = ""
     units: Units = Units(length="m", angle="rad")
-    start: list[float] = Field(min_length=5, max_length=5)
+    start: list[Finite] = Field(min_length=5, max_length=5)
     segments: list[SegmentEntry] = Field(min_length=1)
     limits: LimitsEntry = Field(default_factory=LimitsEntry)
-    sample_rate: float = Field(default=DEFAULT_SAMPLE_RATE, gt=0, le=1e5)
+    sample_rate: float = Field(default=DEFAULT_SAMPLE_RATE, gt=0, le=1e5, allow_inf_nan=False)
     compare: bool = Field(default=True, description="Run the ruckig and toppra comparisons.")
     plot: PlotEntry = Field(default_factory=PlotEntry)
-    expect: Expect = Field(default_factory=Expect)
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs in [m] and [rad] (limits in rad/s^2, rad/s^3)."""
+        length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
+        data = super().si_inputs()
+        data["units"] = dict(SI_UNITS)
+        data["start"] = scaled(self.start, angle)
+        for entry, seg in zip(data["segments"], self.segments, strict=True):
+            entry["to_q"] = scaled(seg.to_q, angle)
+            entry["to_pose"] = scale_translation(seg.to_pose, length)
+        for key in ("acceleration", "jerk"):
+            data["limits"][key] = scaled(getattr(self.limits, key), angle)
+        return data
 
     @model_validator(mode="after")
-    def _plot_segment_exists(self) -> Scenario:
+    def _plot_segment_exists(self) -> Input:
         if self.plot.segment >= len(self.segments):
             raise ValueError(
                 f"plot.segment {self.plot.segment} does not exist "
@@ -149,7 +171,7 @@ class Scenario(StrictModel):
         return self
 
     @model_validator(mode="after")
-    def _configurations_within_joint_limits(self) -> Scenario:
+    def _configurations_within_joint_limits(self) -> Input:
         """Reject a start or ``to_q`` outside the joint limits, naming the key path.
 
         The check needs the file's angle unit, so it runs on the whole scenario; the error
@@ -174,7 +196,7 @@ class Scenario(StrictModel):
                     f"q{j + 1} = {values[j]:g} {self.units.angle} is outside its joint limits "
                     f"[{low:g}, {high:g}] {self.units.angle}"
                 )
-                error = PydanticCustomError("joint_limit", message)  # type: ignore[misc]
+                error = PydanticCustomError("joint_limit", message)
                 raise ValidationError.from_exception_data(
                     type(self).__name__,
                     [InitErrorDetails(type=error, loc=(*loc, int(j)), input=values[j])],
@@ -182,7 +204,10 @@ class Scenario(StrictModel):
         return self
 
 
-def build(scenario: Scenario) -> Plan:
+Scenario = Input
+
+
+def build(scenario: Input) -> Plan:
     """The scenario's plan (SI units)."""
     start = np.array(scenario.start) * angle_factor(scenario.units.angle)
     specs = [entry.spec(scenario.units) for entry in scenario.segments]
@@ -190,7 +215,7 @@ def build(scenario: Scenario) -> Plan:
 
 
 def _report_json(
-    scenario: Scenario, plan: Plan, reports: list[SegmentReport], comparison: Any
+    scenario: Input, plan: Plan, reports: list[SegmentReport], comparison: Any
 ) -> dict[str, Any]:
     limits = plan.limits
     segments = []
@@ -248,35 +273,18 @@ def _report_json(
     return out
 
 
-def _check(scenario: Scenario, reports: list[SegmentReport]) -> list[str]:
-    expect = scenario.expect
-    failed = []
-    for r in reports:
-        if (
-            expect.max_line_deviation is not None
-            and r.max_line_deviation is not None
-            and r.max_line_deviation > expect.max_line_deviation
-        ):
-            failed.append(
-                f"segments[{r.segment}]: line deviation {r.max_line_deviation:.3g} m exceeds "
-                f"{expect.max_line_deviation:.3g} m"
-            )
-        if expect.joint_limits_respected and r.limit_violation_samples:
-            joints = ", ".join(f"q{j + 1}" for j in r.limit_violation_joints)
-            failed.append(
-                f"segments[{r.segment}]: {r.limit_violation_samples} samples outside the joint "
-                f"limits ({joints})"
-            )
-        if (
-            expect.max_branch_switches is not None
-            and r.branch_switches > expect.max_branch_switches
-        ):
-            failed.append(f"segments[{r.segment}]: {r.branch_switches} IK branch switches")
-    return failed
+def _metrics(plan: Plan, reports: list[SegmentReport]) -> dict[str, Any]:
+    deviations = [r.max_line_deviation for r in reports if r.max_line_deviation is not None]
+    return {
+        "line_deviation": max(deviations) if deviations else 0.0,
+        "joint_limits_respected": not any(r.limit_violation_samples for r in reports),
+        "branch_switches": sum(r.branch_switches for r in reports),
+        "duration": plan.duration,
+    }
 
 
-def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Outcome:
-    """Build, sample and compare the plan; write ``report.json`` and the plots."""
+def run(scenario: Input) -> KindOutput:
+    """Build, sample and compare the plan (no files)."""
     plan = build(scenario)
     samples = plan.sample(scenario.sample_rate)
     reports = segment_reports(plan, samples)
@@ -285,40 +293,63 @@ def run(scenario: Scenario, out_dir: Path | None, *, quick: bool = False) -> Out
         from lynxplan.trajectory.retime import compare_plan
 
         comparison = compare_plan(plan, scenario.sample_rate)
-    if out_dir is not None:
-        data = _report_json(scenario, plan, reports, comparison)
-        (out_dir / "report.json").write_text(json.dumps(_finite(data), indent=2))
-        if not quick:
-            _write_plots(scenario, plan, samples, comparison, out_dir)
-    return Outcome(_summary(scenario, plan, reports, comparison), tuple(_check(scenario, reports)))
+    details = _report_json(scenario, plan, reports, comparison)
+    text = _summary(scenario, plan, reports, comparison)
+    notes = {
+        "joint_limits_respected": "; ".join(
+            f"segments[{r.segment}]: {r.limit_violation_samples} samples outside the joint limits "
+            f"({', '.join(f'q{j + 1}' for j in r.limit_violation_joints)})"
+            for r in reports
+            if r.limit_violation_samples
+        ),
+        "branch_switches": "; ".join(
+            f"segments[{r.segment}]: {r.branch_switches} IK branch switches"
+            for r in reports
+            if r.branch_switches
+        ),
+    }
+    return KindOutput(
+        _metrics(plan, reports), text, details, payload=(plan, samples, comparison), notes=notes
+    )
+
+
+def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
+    """``trajectory.csv`` and, unless quick, the plots."""
+    from lynxplan.scenarios.outputs import write_trajectory_csv
+
+    plan, samples, comparison = output.payload
+    write_trajectory_csv(
+        out_dir / "trajectory.csv",
+        samples.t,
+        samples.q,
+        samples.qd,
+        samples.qdd,
+        samples.tool[:, :3, 3],
+    )
+    if quick:
+        return ["trajectory.csv"]
+    return ["trajectory.csv", *_write_plots(scenario, plan, samples, comparison, out_dir)]
 
 
 def _write_plots(
-    scenario: Scenario, plan: Plan, samples: PlanSamples, comparison: Any, out_dir: Path
-) -> None:
+    scenario: Input, plan: Plan, samples: PlanSamples, comparison: Any, out_dir: Path
+) -> list[str]:
     from lynxplan.trajectory import plots
 
+    written = []
     index, joint = scenario.plot.segment, scenario.plot.joint - 1
     if comparison is not None:
         plots.plot_joint_profiles(comparison.segments[index], joint, out_dir / "joint_profiles.png")
         plots.plot_durations(comparison, out_dir / "durations.png")
+        written += ["joint_profiles.png", "durations.png"]
     lines = [i for i, seg in enumerate(plan.segments) if seg.kind == "line"]
     if lines:
         plots.plot_tool_xyz(plan, samples, lines[0], out_dir / "tool_xyz.png")
+        written.append("tool_xyz.png")
+    return written
 
 
-def _finite(value: Any) -> Any:
-    """JSON has no NaN/inf: replace them by None."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
-    if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
-    return value
-
-
-def _summary(scenario: Scenario, plan: Plan, reports: list[SegmentReport], comparison: Any) -> str:
+def _summary(scenario: Input, plan: Plan, reports: list[SegmentReport], comparison: Any) -> str:
     lines = [r for r in reports if r.max_line_deviation is not None]
     text = (
         f"trajectory {scenario.name or ''}: {len(plan.segments)} segments, "

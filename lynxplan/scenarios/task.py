@@ -5,7 +5,7 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
     kind: task
     name: pick and place
     units: {length: in, angle: deg}          # lengths in|mm|m, angles deg|rad
-    robot: {}                                # the shipped AL5 URDF; or {urdf: path/to.urdf}
+    robot: {}                                # the shipped AL5; or {urdf: path/to.urdf}
     sample_rate: 1000                        # [Hz]
     timing: {tt: 2.0, ta: 0.5}               # default of every segment [s]; or: auto
     limits: {acceleration: 450, jerk: 3400}  # per joint (scalar or 5 values), angle unit / s^n
@@ -33,43 +33,46 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
 
 Robots: task scenarios plan with the AL5's analytic IK, so the robot must have the AL5's joint
 structure (the shipped URDF or a variant with other link lengths or collision shapes). A robot of
-another structure (``example_robot_data: <name>``, or another URDF) is loaded and rejected with a
-message saying so; use it with :mod:`lynxplan.viz` and :mod:`lynxplan.collision` directly.
+another structure is rejected at run time with a message saying so.
 
 Relative URDF paths are resolved from the current working directory.
+
+Metrics: ``collision_free``, ``within_limits``, ``min_clearance`` [m], ``duration`` [s],
+``path_deviation`` [m], ``joint_speed`` [rad/s] (peak), ``contacts``. Artifacts:
+``trajectory.csv`` and, unless quick or switched off in ``outputs``, ``task_side.png``,
+``task_top.png``, ``joints.png``, ``clearance.png`` and ``<name>.html``.
 """
 
 from __future__ import annotations
 
-from typing import Annotated, Any, Literal
+from pathlib import Path
+from typing import Annotated, Any, ClassVar, Literal
 
-from pydantic import Discriminator, Field, PrivateAttr, Tag, field_validator, model_validator
+from pydantic import Discriminator, Field, Tag, model_validator
 from typing_extensions import Self
 
-from lynxplan.scenario import StrictModel, Units
-from lynxplan.task.expect import parse_comparison
+from lynxplan.scenarios.base import (
+    SI_UNITS,
+    KindOutput,
+    Quantity,
+    RobotRef,
+    ScenarioModel,
+    StrictModel,
+    Units,
+    located_error,
+    scale_translation,
+    scaled,
+)
 from lynxplan.trajectory.lspb import LspbTiming
+from lynxplan.units import angle_factor, length_factor
+
+NAME = "task"
 
 Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 PerJoint = Positive | Annotated[list[Positive], Field(min_length=5, max_length=5)]
-
-
-class RobotEntry(StrictModel):
-    """Which robot: the shipped AL5 URDF (default), another URDF, or example-robot-data."""
-
-    urdf: str | None = Field(None, description="URDF path (relative to the working directory).")
-    example_robot_data: str | None = Field(
-        None, description="Robot name in example-robot-data (loaded; rejected unless AL5-like)."
-    )
-
-    @model_validator(mode="after")
-    def _at_most_one(self) -> Self:
-        if self.urdf is not None and self.example_robot_data is not None:
-            raise ValueError("give urdf or example_robot_data, not both")
-        return self
 
 
 class _Oriented(StrictModel):
@@ -239,95 +242,125 @@ class OutputsEntry(StrictModel):
     html: bool = True
 
 
-Expectation = str | Finite
-
-
-def _checked(value: Expectation | None, quantity: str, default_op: str | None) -> Any:
-    if value is not None:
-        unit = {"length": "m", "time": "s", "angular_speed": "rad/s", "count": ""}[quantity]
-        parse_comparison(value, quantity, unit, default_op)
-    return value
-
-
-class Expect(StrictModel):
-    """What the run must measure. Comparisons are ``"<op> <number> [unit]"`` strings."""
-
-    collision_free: bool | None = Field(
-        None, description="No contact at any sample nor between samples (certified)."
-    )
-    within_limits: bool | None = Field(
-        None, description="Position, velocity and acceleration limits hold on every sample."
-    )
-    min_clearance: Expectation | None = Field(
-        None, description="Overall minimum clearance, e.g. '>= 0.2 in' (bare number: >=)."
-    )
-    max_duration: Expectation | None = Field(None, description="Planned duration (bare: <=).")
-    max_path_deviation: Expectation | None = Field(
-        None, description="Largest tool deviation from a straight line (bare number: <=)."
-    )
-    max_joint_speed: Expectation | None = Field(
-        None, description="Peak |qd| over joints, e.g. '<= 90 deg/s' (bare number: <=)."
-    )
-    contacts: Expectation | None = Field(None, description="Number of contacts, e.g. '== 0'.")
-
-    @field_validator("min_clearance")
-    @classmethod
-    def _length_min(cls, value: Expectation | None) -> Any:
-        return _checked(value, "length", ">=")
-
-    @field_validator("max_path_deviation")
-    @classmethod
-    def _length_max(cls, value: Expectation | None) -> Any:
-        return _checked(value, "length", "<=")
-
-    @field_validator("max_duration")
-    @classmethod
-    def _time(cls, value: Expectation | None) -> Any:
-        return _checked(value, "time", "<=")
-
-    @field_validator("max_joint_speed")
-    @classmethod
-    def _speed(cls, value: Expectation | None) -> Any:
-        return _checked(value, "angular_speed", "<=")
-
-    @field_validator("contacts")
-    @classmethod
-    def _count(cls, value: Expectation | None) -> Any:
-        return _checked(value, "count", "<=")
-
-
-class Scenario(StrictModel):
+class Input(ScenarioModel):
     """A ``task`` scenario: an arm moving through named waypoints among obstacles."""
 
+    metrics: ClassVar[dict[str, Quantity]] = {
+        "collision_free": "bool",
+        "within_limits": "bool",
+        "min_clearance": "length",
+        "duration": "time",
+        "path_deviation": "length",
+        "joint_speed": "angular_speed",
+        "contacts": "count",
+    }
+
     kind: Literal["task"]
-    name: str = ""
-    description: str = ""
     units: Units = Units(length="m", angle="rad")
-    robot: RobotEntry = Field(default_factory=RobotEntry)
+    robot: RobotRef = Field(default_factory=RobotRef)
     sample_rate: Positive = Field(1000.0, le=1e5, description="Samples per second, in [Hz].")
     timing: Timing = Field("auto", description="Default timing of every segment.")
     limits: LimitsEntry = Field(default_factory=LimitsEntry)
-    obstacles: list[ObstacleEntry] = Field(default_factory=list)
-    waypoints: dict[str, WaypointEntry] = Field(min_length=1)
-    segments: list[SegmentEntry] = Field(min_length=1)
+    obstacles: list[ObstacleEntry] = Field(default_factory=list, max_length=1000)
+    waypoints: dict[str, WaypointEntry] = Field(min_length=1, max_length=10_000)
+    segments: list[SegmentEntry] = Field(min_length=1, max_length=10_000)
     writing_plane: WritingPlaneEntry | None = None
     self_collision: bool = Field(False, description="Also check non-adjacent link pairs.")
     compare: bool = Field(True, description="Run the ruckig and toppra comparisons.")
     outputs: OutputsEntry = Field(default_factory=OutputsEntry)
-    expect: Expect = Field(default_factory=Expect)
 
-    _setup: Any = PrivateAttr(default=None)
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs in [m] and [rad] (limits in rad/s^n)."""
+        length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
+        data = super().si_inputs()
+        data["units"] = dict(SI_UNITS)
+        for entry in data["obstacles"]:
+            for key in ("min_corner", "centre", "size", "radius", "length"):
+                entry[key] = scaled(entry.get(key), length)
+            entry["rpy"] = scaled(entry.get("rpy"), angle)
+        for entry in data["waypoints"].values():
+            entry["q"] = scaled(entry["q"], angle)
+            entry["q_reference"] = scaled(entry["q_reference"], angle)
+            entry["position"] = scaled(entry["position"], length)
+            entry["pose"] = scale_translation(entry["pose"], length)
+        for key in ("velocity", "acceleration", "jerk"):
+            data["limits"][key] = scaled(data["limits"][key], angle)
+        if data["writing_plane"] is not None:
+            plane = data["writing_plane"]
+            plane.update(
+                point=scaled(plane["point"], length),
+                size=scaled(plane["size"], length),
+                tilt=scaled(plane["tilt"], angle),
+            )
+        return data
 
-    @classmethod
-    def model_validate(cls, obj: Any, **kwargs: Any) -> Self:
-        """Validate the schema, then resolve it: robot, obstacles, waypoints (IK), the plan.
+    @model_validator(mode="after")
+    def _route_names_exist(self) -> Self:
+        from lynxplan.exceptions import ScenarioValueError
+        from lynxplan.task.setup import route
 
-        Problems found while resolving (unknown waypoint names, unreachable waypoints, a line
-        leaving the reach, a non-AL5 robot) are raised as a ``ValidationError`` located at their
-        key path, like schema errors.
-        """
-        scenario = super().model_validate(obj, **kwargs)
-        from lynxplan.task.setup import resolve
+        try:
+            route(self)
+        except ScenarioValueError as exc:
+            raise located_error(exc.loc, exc.reason, exc.value) from None
+        return self
 
-        scenario._setup = resolve(scenario)
-        return scenario
+
+Scenario = Input
+
+
+def run(scenario: Input) -> KindOutput:
+    """Resolve the scenario (IK of the waypoints, the plan), sample, check, compare (no files)."""
+    from lynxplan.progress import progress_bar
+    from lynxplan.task.report import summary, task_details, task_metrics, task_notes
+    from lynxplan.task.run import execute
+    from lynxplan.task.setup import resolve
+
+    with progress_bar(f"task {scenario.name}".strip()) as progress:
+        setup = resolve(scenario)
+        result = execute(scenario, setup, progress)
+        progress(5, 5)
+    return KindOutput(
+        task_metrics(result),
+        summary(scenario, result),
+        task_details(scenario, result),
+        payload=result,
+        stage_seconds=result.stage_seconds,
+        notes=task_notes(result),
+    )
+
+
+def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
+    """``trajectory.csv`` and, unless quick, the plots and the meshcat HTML."""
+    from lynxplan.scenarios.outputs import write_trajectory_csv
+    from lynxplan.task.run import html_name
+
+    result = output.payload
+    samples = result.samples
+    write_trajectory_csv(
+        out_dir / "trajectory.csv",
+        samples.t,
+        samples.q,
+        samples.qd,
+        samples.qdd,
+        samples.tool[:, :3, 3],
+    )
+    written = ["trajectory.csv"]
+    if quick:
+        return written
+    if scenario.outputs.plots:
+        from lynxplan.scenarios.expect import parse_expectation
+        from lynxplan.task.plots import write_plots
+
+        required = None
+        if "min_clearance" in scenario.expect:
+            required = parse_expectation(
+                "min_clearance", scenario.expect["min_clearance"], Input.metrics, scenario.units
+            )
+        written += write_plots(scenario, result, out_dir, required)
+    if scenario.outputs.html:
+        from lynxplan.task.html import write_html
+
+        write_html(scenario, result, out_dir / html_name(scenario))
+        written.append(html_name(scenario))
+    return written

@@ -1,0 +1,170 @@
+"""Planning problems: a start configuration and a goal (configuration, tool pose, or position +
+approach direction), turned into the set of goal configurations the planner may reach.
+
+- :class:`JointGoal`: one configuration.
+- :class:`PoseGoal`: a tool pose; every IK branch within the joint limits is a goal (the planner
+  grows its goal tree from all of them, so a goal that needs a branch change is found).
+- :class:`ApproachGoal`: a tool position and approach direction (the tool z axis); the roll
+  about the approach axis is free: IK branches at ``roll_samples`` rolls are all goals.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from lynxplan.exceptions import (
+    GoalUnreachableError,
+    KinematicsError,
+    NonFiniteInputError,
+    ShapeError,
+)
+from lynxplan.planning.space import JointSpace
+
+#: Rolls about the approach axis tried for an :class:`ApproachGoal`.
+DEFAULT_ROLL_SAMPLES = 8
+
+
+@dataclass(frozen=True)
+class JointGoal:
+    """A goal configuration.
+
+    Attributes:
+        q: Joint angles, shape (nq,), in [rad].
+    """
+
+    q: np.ndarray
+
+    def __post_init__(self) -> None:
+        array = np.array(self.q, dtype=float)
+        array.setflags(write=False)
+        object.__setattr__(self, "q", array)
+
+
+@dataclass(frozen=True)
+class PoseGoal:
+    """A tool pose; any IK branch is a valid goal.
+
+    Attributes:
+        pose: Tool pose in the base frame, shape (4, 4), translation in [m].
+    """
+
+    pose: np.ndarray
+
+    def __post_init__(self) -> None:
+        array = np.array(self.pose, dtype=float)
+        if array.shape != (4, 4):
+            raise ShapeError("goal pose", "(4, 4)", array.shape)
+        if not np.isfinite(array).all():
+            raise NonFiniteInputError("goal pose")
+        array.setflags(write=False)
+        object.__setattr__(self, "pose", array)
+
+
+@dataclass(frozen=True)
+class ApproachGoal:
+    """A tool position and approach direction (tool z axis); the roll about it is free.
+
+    Attributes:
+        position: Tool point, shape (3,), in [m].
+        approach: Approach direction, shape (3,) (normalised here).
+        roll_samples: Number of rolls about the approach axis turned into IK goals.
+    """
+
+    position: np.ndarray
+    approach: np.ndarray
+    roll_samples: int = DEFAULT_ROLL_SAMPLES
+
+    def __post_init__(self) -> None:
+        for name in ("position", "approach"):
+            array = np.array(getattr(self, name), dtype=float)
+            if array.shape != (3,):
+                raise ShapeError(f"goal {name}", "(3,)", array.shape)
+            if not np.isfinite(array).all():
+                raise NonFiniteInputError(f"goal {name}")
+            if name == "approach":
+                norm = float(np.linalg.norm(array))
+                if norm == 0.0:
+                    raise ShapeError("goal approach", "a non-zero vector", array.shape)
+                array = array / norm
+            array.setflags(write=False)
+            object.__setattr__(self, name, array)
+
+    def poses(self) -> np.ndarray:
+        """Tool poses at ``roll_samples`` rolls about the approach axis, shape (R, 4, 4)."""
+        z = self.approach
+        helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        x0 = np.cross(helper, z)
+        x0 /= np.linalg.norm(x0)
+        y0 = np.cross(z, x0)
+        poses = np.zeros((self.roll_samples, 4, 4))
+        for k, angle in enumerate(np.linspace(0.0, 2 * np.pi, self.roll_samples, endpoint=False)):
+            x = np.cos(angle) * x0 + np.sin(angle) * y0
+            poses[k, :3, :3] = np.column_stack((x, np.cross(z, x), z))
+            poses[k, :3, 3] = self.position
+            poses[k, 3, 3] = 1.0
+        return poses
+
+
+Goal = JointGoal | PoseGoal | ApproachGoal
+
+
+@dataclass(frozen=True)
+class GoalSet:
+    """The goal configurations of a goal, with where each came from.
+
+    Attributes:
+        configurations: Shape (K, nq), in [rad], within the joint limits.
+        labels: One label per configuration (IK branch name, roll), for reports.
+    """
+
+    configurations: np.ndarray
+    labels: tuple[str, ...] = field(default=())
+
+
+def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> GoalSet:
+    """Every configuration reaching ``goal`` within the joint limits (IK: every branch).
+
+    A bare array is taken as a joint goal (shape (nq,)) or a pose goal (shape (4, 4)).
+
+    Raises:
+        ShapeError, NonFiniteInputError, ConfigurationOutsideLimitsError: bad goal.
+        GoalUnreachableError: a pose/approach goal with no IK branch within the limits.
+    """
+    if not isinstance(goal, JointGoal | PoseGoal | ApproachGoal):
+        array = np.asarray(goal, dtype=float)
+        goal = PoseGoal(array) if array.shape == (4, 4) else JointGoal(array)
+    if isinstance(goal, JointGoal):
+        return GoalSet(space.check(goal.q, "goal")[None, :], ("joint goal",))
+    approach_only = isinstance(goal, ApproachGoal)
+    if isinstance(goal, PoseGoal):
+        poses, references = goal.pose[None], [None]
+    else:
+        # The roll about the approach axis is the last joint's (yaw-pitch^3-roll family): one
+        # IK per sampled last-joint angle.
+        rolls = np.linspace(space.lower[-1], space.upper[-1], goal.roll_samples)
+        poses = np.repeat(goal.poses()[:1], len(rolls), axis=0)
+        references = [np.r_[np.zeros(space.dimension - 1), roll] for roll in rolls]
+    found: list[np.ndarray] = []
+    labels: list[str] = []
+    reasons: list[str] = []
+    for pose, reference in zip(poses, references, strict=True):
+        try:
+            result = robot.ik(pose, approach_only=approach_only, strict=True, q_reference=reference)
+        except KinematicsError as exc:
+            reasons.append(str(exc))
+            continue
+        for solution in result.solutions:
+            q = np.asarray(solution.q, dtype=float)
+            if not solution.within_limits or not np.isfinite(q).all():
+                continue
+            if any(np.allclose(q, other, atol=1e-9, rtol=0) for other in found):
+                continue
+            found.append(np.clip(q, space.lower, space.upper))
+            suffix = f" roll {np.degrees(q[-1]):.0f} deg" if approach_only else ""
+            labels.append(f"{solution.branch}{suffix}")
+    if not found:
+        raise GoalUnreachableError(reasons[0] if reasons else "no IK branch within the limits")
+    return GoalSet(np.array(found), tuple(labels))

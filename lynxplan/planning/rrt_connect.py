@@ -1,0 +1,271 @@
+"""Bidirectional RRT-Connect (Kuffner & LaValle 2000) with goal biasing, compiled with numba.
+
+Two trees: tree 0 rooted at the start, tree 1 rooted at every goal configuration (a pose goal
+gives one root per collision-free IK branch). Each iteration, in the compiled kernel:
+
+1. sample a configuration uniformly in the joint limits (with probability ``goal_bias``, a root
+   of the other tree instead);
+2. *extend* the active tree: from its nearest node (linear scan, Euclidean) one step of at most
+   ``step`` [rad] towards the sample; the edge is certified by the validity checker's
+   conservative advancement (:func:`lynxplan.planning.validity.edge_fraction`);
+3. *connect* the other tree to the new node: the straight edge from its nearest node is walked
+   as far as it is certified; nodes are added every ``step`` along it; reaching the new node
+   joins the trees;
+4. swap the trees.
+
+The planner knows nothing about the robot: only the joint box, the kernel arrays of the checker
+and a random state (:mod:`lynxplan.planning.rng`). The caller runs the kernel in chunks of
+iterations and checks its time limit between chunks; the state lives in arrays, so the result
+depends on the seed only.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from typing import Any
+
+import numba
+import numpy as np
+
+from lynxplan.exceptions import PlanningFailed
+from lynxplan.planning import rng as _rng
+from lynxplan.planning.validity import ValidityChecker, edge_fraction
+
+#: Kernel status codes.
+RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2
+#: Iterations per kernel call between two time-limit checks.
+CHUNK_ITERATIONS = 64
+
+
+@dataclass(frozen=True)
+class RrtConnectSettings:
+    """Settings of RRT-Connect.
+
+    Attributes:
+        step: Longest extension towards a sample, Euclidean in joint space, in [rad].
+        goal_bias: Probability of sampling the other tree's root instead of a random state.
+        max_nodes: Node budget of each tree.
+    """
+
+    step: float = 0.6
+    goal_bias: float = 0.1
+    max_nodes: int = 20000
+
+
+@dataclass(frozen=True)
+class RrtConnectResult:
+    """A path found by RRT-Connect.
+
+    Attributes:
+        path: Waypoints from the start to one goal, shape (N, nq), in [rad].
+        goal_index: Which goal configuration (root of tree 1) the path ends at.
+        nodes: Nodes created in both trees.
+        iterations: Sampling iterations made.
+        elapsed: Time spent, in [s].
+    """
+
+    path: np.ndarray
+    goal_index: int
+    nodes: int
+    iterations: int
+    elapsed: float
+
+
+@numba.njit(cache=True)
+def _nearest(nodes: np.ndarray, count: int, q: np.ndarray) -> int:
+    best, best_index = np.inf, 0
+    nq = q.shape[0]
+    for i in range(count):
+        total = 0.0
+        for j in range(nq):
+            d = nodes[i, j] - q[j]
+            total += d * d
+        if total < best:
+            best, best_index = total, i
+    return best_index
+
+
+@numba.njit(cache=True)
+def _add(
+    nodes: np.ndarray,
+    parents: np.ndarray,
+    counts: np.ndarray,
+    tree: int,
+    q: np.ndarray,
+    parent: int,
+) -> int:
+    index = counts[tree]
+    nodes[tree, index, :] = q
+    parents[tree, index] = parent
+    counts[tree] = index + 1
+    return int(index)
+
+
+@numba.njit(cache=True)
+def rrt_connect_kernel(
+    lower: np.ndarray,
+    upper: np.ndarray,
+    step: float,
+    goal_bias: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    nodes: np.ndarray,
+    parents: np.ndarray,
+    counts: np.ndarray,
+    roots: np.ndarray,
+    state: np.ndarray,
+    meta: np.ndarray,
+    iterations: int,
+) -> int:
+    """Run up to ``iterations`` RRT-Connect iterations; returns RUNNING, SOLVED or NODE_LIMIT.
+
+    nodes: (2, M, nq); parents: (2, M); counts: (2,) nodes per tree; roots: (2,) root counts;
+    state: random state (1,) uint64; meta: [active tree, joint node tree 0, joint node tree 1,
+    iterations done] (int64).
+    """
+    nq = lower.shape[0]
+    capacity = nodes.shape[1]
+    sample = np.empty(nq)
+    new = np.empty(nq)
+    for _ in range(iterations):
+        a = meta[0]
+        b = 1 - a
+        meta[3] += 1
+        if counts[0] + 2 >= capacity or counts[1] + 2 >= capacity:
+            return NODE_LIMIT
+        if _rng.uniform(state) < goal_bias:
+            pick = _rng.integer(state, roots[b])
+            sample[:] = nodes[b, pick]
+        else:
+            for j in range(nq):
+                sample[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
+        near = _nearest(nodes[a], counts[a], sample)
+        distance = 0.0
+        for j in range(nq):
+            distance += (sample[j] - nodes[a, near, j]) ** 2
+        distance = math.sqrt(distance)
+        if distance < 1e-12:
+            meta[0] = b
+            continue
+        fraction = min(1.0, step / distance)
+        for j in range(nq):
+            new[j] = nodes[a, near, j] + fraction * (sample[j] - nodes[a, near, j])
+        if edge_fraction(nodes[a, near], new, model, scratch, clearance) < 1.0:
+            meta[0] = b
+            continue
+        added = _add(nodes, parents, counts, a, new, near)
+        # Connect tree b to the new node as far as the straight edge is certified.
+        other = _nearest(nodes[b], counts[b], new)
+        base = nodes[b, other].copy()
+        length = 0.0
+        for j in range(nq):
+            length += (new[j] - base[j]) ** 2
+        length = math.sqrt(length)
+        reached = edge_fraction(base, new, model, scratch, clearance)
+        parent = other
+        pieces = max(1, int(math.ceil(length / step)))
+        for k in range(1, pieces + 1):
+            s = k / pieces
+            if s > reached:
+                break
+            if counts[b] + 1 >= capacity:
+                return NODE_LIMIT
+            for j in range(nq):
+                sample[j] = base[j] + s * (new[j] - base[j])
+            parent = _add(nodes, parents, counts, b, sample, parent)
+        if reached >= 1.0:
+            meta[1 + a] = added
+            meta[1 + b] = parent
+            return SOLVED
+        meta[0] = b
+    return RUNNING
+
+
+def _branch(nodes: np.ndarray, parents: np.ndarray, tree: int, index: int) -> list[np.ndarray]:
+    branch = []
+    while index >= 0:
+        branch.append(nodes[tree, index].copy())
+        index = int(parents[tree, index])
+    return branch
+
+
+def _root_of(parents: np.ndarray, tree: int, index: int) -> int:
+    while parents[tree, index] >= 0:
+        index = int(parents[tree, index])
+    return index
+
+
+def rrt_connect(
+    checker: ValidityChecker,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    start: np.ndarray,
+    goals: np.ndarray,
+    *,
+    seed: int,
+    time_limit: float,
+    settings: RrtConnectSettings = RrtConnectSettings(),
+) -> RrtConnectResult:
+    """Plan from ``start`` (nq,) to any of ``goals`` (K, nq), in [rad].
+
+    The start and every goal must be valid for the checker (the caller checks them first).
+
+    Raises:
+        PlanningFailed: the time limit [s] or the node budget was reached first.
+    """
+    began = time.perf_counter()
+    nq = lower.size
+    capacity = settings.max_nodes + 1
+    nodes = np.zeros((2, capacity, nq))
+    parents = np.full((2, capacity), -1, dtype=np.int64)
+    counts = np.array([1, len(goals)], dtype=np.int64)
+    nodes[0, 0] = start
+    nodes[1, : len(goals)] = goals
+    roots = counts.copy()
+    state = _rng.seed_state(seed)
+    meta = np.array([0, -1, -1, 0], dtype=np.int64)
+    for k, goal in enumerate(goals):  # the straight edge first: free space needs no tree
+        if checker.edge_fraction(start, goal) >= 1.0:
+            path = np.vstack([start, goal])
+            return RrtConnectResult(path, k, int(counts.sum()), 0, time.perf_counter() - began)
+    model, scratch, clearance = checker.model, checker.scratch, checker.clearance
+    while True:
+        status = rrt_connect_kernel(
+            lower,
+            upper,
+            settings.step,
+            settings.goal_bias,
+            model,
+            scratch,
+            clearance,
+            nodes,
+            parents,
+            counts,
+            roots,
+            state,
+            meta,
+            CHUNK_ITERATIONS,
+        )
+        elapsed = time.perf_counter() - began
+        if status == SOLVED:
+            break
+        if status == NODE_LIMIT:
+            raise PlanningFailed(
+                int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes}"
+            )
+        if elapsed >= time_limit:
+            raise PlanningFailed(
+                int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s"
+            )
+    from_start = _branch(nodes, parents, 0, int(meta[1]))[::-1]
+    to_goal = _branch(nodes, parents, 1, int(meta[2]))
+    path = np.array(from_start + to_goal)
+    keep = np.ones(len(path), dtype=bool)
+    keep[1:] = np.linalg.norm(np.diff(path, axis=0), axis=1) > 1e-12
+    goal_index = _root_of(parents, 1, int(meta[2]))
+    return RrtConnectResult(
+        path[keep], goal_index, int(counts.sum()), int(meta[3]), time.perf_counter() - began
+    )

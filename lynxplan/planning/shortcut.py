@@ -1,0 +1,143 @@
+"""Path shortcutting and smoothing, compiled with numba; every change is re-validated.
+
+Two passes over a piecewise-linear joint path, both with the planner's validity checker:
+
+1. *Partial shortcutting* (Geraerts & Overmars 2007): pick two random points of the path by arc
+   length (anywhere on its segments, not only at waypoints); if the straight edge between them
+   is certified free (conservative advancement), it replaces the part of the path between them.
+   Cutting between interior points rounds corners off progressively, so this pass also smooths
+   the path towards the taut one; each accepted cut shortens the path (triangle inequality).
+2. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
+
+The parts of the old path kept around a cut are pieces of certified edges, and the cut itself is
+certified before it is accepted: the path stays valid after every change ("verify after every
+shortcut" — pyroboplan's ``shortcut_path`` does not, and returns paths through obstacles).
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numba
+import numpy as np
+
+from lynxplan.planning import rng as _rng
+from lynxplan.planning.validity import ValidityChecker, edge_fraction
+
+#: Shortcut attempts by default.
+DEFAULT_SHORTCUT_ITERATIONS = 60
+#: Points closer than this in joint space are merged, in [rad].
+_MERGE_DISTANCE = 1e-9
+
+
+@numba.njit(cache=True)
+def _point_at(
+    path: np.ndarray, cumulative: np.ndarray, count: int, u: float, out: np.ndarray
+) -> int:
+    """The point at arc length u into out (nq,); returns its segment index."""
+    segment = 0
+    while segment < count - 2 and cumulative[segment + 1] <= u:
+        segment += 1
+    length = cumulative[segment + 1] - cumulative[segment]
+    s = 0.0 if length <= 0.0 else (u - cumulative[segment]) / length
+    s = min(max(s, 0.0), 1.0)
+    for j in range(path.shape[1]):
+        out[j] = path[segment, j] + s * (path[segment + 1, j] - path[segment, j])
+    return segment
+
+
+@numba.njit(cache=True)
+def _distance(a: np.ndarray, b: np.ndarray) -> float:
+    total = 0.0
+    for j in range(a.shape[0]):
+        total += (a[j] - b[j]) ** 2
+    return float(np.sqrt(total))
+
+
+@numba.njit(cache=True)
+def shortcut_kernel(
+    path: np.ndarray,
+    count: int,
+    iterations: int,
+    state: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    work: np.ndarray,
+) -> int:
+    """Partial shortcuts then vertex pruning, in place on path[:count]; returns the new count.
+
+    path: (capacity, nq) with capacity >= count + 2 * iterations; work: same shape.
+    """
+    nq = path.shape[1]
+    cumulative = np.empty(path.shape[0])
+    first = np.empty(nq)
+    second = np.empty(nq)
+    for _ in range(iterations):
+        if count < 3:
+            break
+        cumulative[0] = 0.0
+        for k in range(1, count):
+            cumulative[k] = cumulative[k - 1] + _distance(path[k - 1], path[k])
+        total = cumulative[count - 1]
+        u1 = _rng.uniform(state) * total
+        u2 = _rng.uniform(state) * total
+        if u1 > u2:
+            u1, u2 = u2, u1
+        i1 = _point_at(path, cumulative, count, u1, first)
+        i2 = _point_at(path, cumulative, count, u2, second)
+        if i1 == i2:
+            continue
+        if edge_fraction(first, second, model, scratch, clearance) < 1.0:
+            continue
+        # New path: path[0..i1], first, second, path[i2+1..count-1].
+        size = 0
+        for k in range(i1 + 1):
+            work[size] = path[k]
+            size += 1
+        if _distance(first, work[size - 1]) > _MERGE_DISTANCE:
+            work[size] = first
+            size += 1
+        if _distance(second, path[i2 + 1]) > _MERGE_DISTANCE:
+            work[size] = second
+            size += 1
+        for k in range(i2 + 1, count):
+            work[size] = path[k]
+            size += 1
+        for k in range(size):
+            path[k] = work[k]
+        count = size
+    k = 1
+    while k < count - 1:
+        if edge_fraction(path[k - 1], path[k + 1], model, scratch, clearance) >= 1.0:
+            for m in range(k, count - 1):
+                path[m] = path[m + 1]
+            count -= 1
+        else:
+            k += 1
+    return count
+
+
+def shortcut(
+    checker: ValidityChecker,
+    path: np.ndarray,
+    *,
+    seed: int,
+    iterations: int = DEFAULT_SHORTCUT_ITERATIONS,
+) -> np.ndarray:
+    """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path.
+
+    Deterministic for a given ``seed``; ``iterations`` random cuts are attempted.
+    """
+    count = len(path)
+    capacity = count + 2 * iterations + 2
+    buffer = np.zeros((capacity, path.shape[1]))
+    buffer[:count] = path
+    work = np.zeros_like(buffer)
+    # A stream of its own: the planner's draws and the shortcutter's never overlap.
+    state = _rng.seed_state(seed ^ 0x5DEECE66D)
+    count = shortcut_kernel(
+        buffer, count, iterations, state, checker.model, checker.scratch, checker.clearance, work
+    )
+    result: np.ndarray = buffer[:count].copy()
+    return result

@@ -1,0 +1,184 @@
+"""Time-parameterisation of a planned path under joint velocity/acceleration (and jerk) limits.
+
+The path is a chain of straight joint segments that were certified collision-free; any motion
+that leaves them would have to be checked again. Every method here therefore moves along each
+segment with one scalar law ``q(t) = q_k + s(t) (q_k+1 - q_k)``, ``s`` from 0 to 1, at rest at
+the waypoints (the joints are synchronised by construction, the trajectory *is* the path):
+
+- ``"ruckig"`` (default): ruckig's time-optimal jerk-limited profile of ``s``, with the limits
+  of ``s`` the tightest over the joints (``v_s = min_j v_j / |dq_j|``, same for acceleration
+  and jerk);
+- ``"lspb"``: the report's linear segment with parabolic blends, the shortest one within the
+  limits (:func:`lynxplan.trajectory.timing.auto_timing_linear`);
+- ``"toppra"``: toppra's time-optimal parameterisation of the segment under the joint velocity
+  and acceleration limits (for a straight segment it is the bang-coast-bang LSPB; kept for
+  comparison with the other tools).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import NamedTuple
+
+import numpy as np
+
+from lynxplan.exceptions import InputError, RetimingError
+from lynxplan.trajectory.lspb import unit_lspb
+from lynxplan.trajectory.timing import auto_timing_linear
+
+METHODS = ("ruckig", "lspb", "toppra")
+#: Default sample rate of the time-parameterised trajectory, in [Hz].
+DEFAULT_SAMPLE_RATE = 100.0
+
+
+class TimedPath(NamedTuple):
+    """A sampled joint trajectory along a path.
+
+    Attributes:
+        t: Sample times, shape (N,), in [s].
+        q: Joint angles, shape (N, nq), in [rad].
+        qd: Joint velocities, shape (N, nq), in [rad/s].
+        qdd: Joint accelerations, shape (N, nq), in [rad/s^2].
+        segment: Path segment of each sample, shape (N,).
+    """
+
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    qdd: np.ndarray
+    segment: np.ndarray
+
+
+def _unit_limit(limit: np.ndarray, delta: np.ndarray) -> float:
+    moving = np.abs(delta) > 0
+    return float(np.min(limit[moving] / np.abs(delta[moving])))
+
+
+def _ruckig_law(
+    delta: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray, rate: float
+) -> tuple[np.ndarray, ...]:
+    from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
+
+    params = InputParameter(1)
+    params.current_position, params.target_position = [0.0], [1.0]
+    params.current_velocity = params.current_acceleration = [0.0]
+    params.target_velocity = params.target_acceleration = [0.0]
+    params.max_velocity = [_unit_limit(velocity, delta)]
+    params.max_acceleration = [_unit_limit(acceleration, delta)]
+    params.max_jerk = [_unit_limit(jerk, delta)]
+    trajectory = Trajectory(1)
+    try:
+        result = Ruckig(1).calculate(params, trajectory)
+    except RuckigError as exc:
+        raise RetimingError("ruckig", str(exc).strip().splitlines()[0]) from exc
+    if result not in (Result.Working, Result.Finished):
+        raise RetimingError("ruckig", str(result))
+    t = _times(float(trajectory.duration), rate)
+    states = np.array([trajectory.at_time(float(x)) for x in t])[:, :, 0]  # (N, 3)
+    return t, states[:, 0], states[:, 1], states[:, 2]
+
+
+def _lspb_law(
+    delta: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, rate: float
+) -> tuple[np.ndarray, ...]:
+    timing = auto_timing_linear(delta, velocity, acceleration)
+    t = _times(timing.tt, rate)
+    s = unit_lspb(t, timing)
+    return t, s.position, s.velocity, s.acceleration
+
+
+def _toppra_law(
+    delta: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, rate: float
+) -> tuple[np.ndarray, ...]:
+    import toppra
+    import toppra.algorithm
+    import toppra.constraint
+
+    grid = np.linspace(0.0, 1.0, 21)
+    path = toppra.SplineInterpolator(grid, grid[:, None] * delta[None, :])
+    v = toppra.constraint.JointVelocityConstraint(np.column_stack([-velocity, velocity]))
+    a = toppra.constraint.JointAccelerationConstraint(
+        np.column_stack([-acceleration, acceleration])
+    )
+    algorithm = toppra.algorithm.TOPPRA(
+        [v, a], path, gridpoints=grid, parametrizer="ParametrizeConstAccel"
+    )
+    trajectory = algorithm.compute_trajectory(0.0, 0.0)
+    if trajectory is None:
+        raise RetimingError("toppra", "the segment is not parameterisable under the limits")
+    t = _times(float(trajectory.duration), rate)
+    # Project toppra's joint samples on the segment: s from the largest-moving joint.
+    j = int(np.argmax(np.abs(delta)))
+    s = trajectory(t)[:, j] / delta[j]
+    sd = trajectory(t, 1)[:, j] / delta[j]
+    sdd = trajectory(t, 2)[:, j] / delta[j]
+    return t, np.clip(s, 0.0, 1.0), sd, sdd
+
+
+def _times(duration: float, rate: float) -> np.ndarray:
+    count = max(2, int(math.ceil(duration * rate - 1e-9)) + 1)
+    return np.linspace(0.0, duration, count)
+
+
+def time_parameterize(
+    waypoints: np.ndarray,
+    velocity: np.ndarray,
+    acceleration: np.ndarray,
+    jerk: np.ndarray,
+    *,
+    method: str = "ruckig",
+    rate: float = DEFAULT_SAMPLE_RATE,
+) -> TimedPath:
+    """Rest-to-rest motion along each straight segment of a path, sampled at ``rate``.
+
+    Args:
+        waypoints: Shape (N, nq), in [rad].
+        velocity: Joint speed limits, shape (nq,), in [rad/s].
+        acceleration: Joint acceleration limits, shape (nq,), in [rad/s^2].
+        jerk: Joint jerk limits, shape (nq,), in [rad/s^3] (ruckig only).
+        method: One of :data:`METHODS`.
+        rate: Sample rate, in [Hz]; every segment's end is a sample too.
+
+    Raises:
+        InputError: unknown method or non-positive rate.
+        RetimingError: a library found no profile.
+    """
+    if method not in METHODS:
+        raise InputError(f"timing method must be one of {', '.join(METHODS)}. Got: {method!r}")
+    if not math.isfinite(rate) or rate <= 0:
+        raise InputError(f"sample rate must be positive. Got: {rate!r} Hz")
+    path = np.asarray(waypoints, dtype=float)
+    nq = path.shape[1]
+    times, qs, qds, qdds, segments = (
+        [np.zeros(1)],
+        [path[:1]],
+        [np.zeros((1, nq))],
+        [np.zeros((1, nq))],
+        [np.zeros(1, dtype=np.int64)],
+    )
+    offset = 0.0
+    for k in range(len(path) - 1):
+        delta = path[k + 1] - path[k]
+        if not np.any(np.abs(delta) > 0):
+            continue
+        if method == "ruckig":
+            t, s, sd, sdd = _ruckig_law(delta, velocity, acceleration, jerk, rate)
+        elif method == "lspb":
+            t, s, sd, sdd = _lspb_law(delta, velocity, acceleration, rate)
+        else:
+            t, s, sd, sdd = _toppra_law(delta, velocity, acceleration, rate)
+        s = s[1:]
+        s[-1] = 1.0  # the segment ends exactly on the waypoint
+        times.append(offset + t[1:])
+        qs.append(path[k] + s[:, None] * delta)
+        qds.append(sd[1:, None] * delta)
+        qdds.append(sdd[1:, None] * delta)
+        segments.append(np.full(len(s), k, dtype=np.int64))
+        offset += float(t[-1])
+    return TimedPath(
+        np.concatenate(times),
+        np.concatenate(qs),
+        np.concatenate(qds),
+        np.concatenate(qdds),
+        np.concatenate(segments),
+    )

@@ -1,0 +1,233 @@
+"""The scenario contract: the input base model, a kind's output, and the frozen run result.
+
+A scenario kind is one module of :mod:`lynxplan.scenarios` registered in
+:data:`lynxplan.scenarios.registry.KIND_MODULES`. It defines
+
+- ``Input``: a :class:`ScenarioModel` subclass (validation only, never computation) whose
+  ``metrics`` class variable declares the metrics ``run`` measures and their quantities;
+- ``run(scenario) -> KindOutput``: the computation, pure (writes no file);
+- ``write_outputs(scenario, output, out_dir, *, quick) -> list[str]``: the artifacts (CSV, PNG,
+  HTML) written into ``out_dir``, returned as paths relative to it.
+
+The runner (:mod:`lynxplan.scenarios.runner`) evaluates the ``expect:`` block against the metrics
+with one parser (:mod:`lynxplan.scenarios.expect`) and writes ``report.json``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, ClassVar, Literal, Protocol
+
+from pydantic import BaseModel, ConfigDict, Field, model_validator
+
+#: Version of the ``report.json`` layout (:class:`Result`); bumped on incompatible changes.
+SCHEMA_VERSION = 1
+
+#: Physical quantity of a metric: selects the units an expectation may use.
+Quantity = Literal[
+    "length",
+    "angle",
+    "time",
+    "angular_speed",
+    "area",
+    "volume",
+    "count",
+    "ratio",
+    "bool",
+    "flags",
+]
+
+
+def located_error(loc: tuple[int | str, ...], message: str, value: Any = None) -> Exception:
+    """A pydantic ValidationError at key path ``loc`` (raised from a model validator)."""
+    from pydantic import ValidationError
+    from pydantic_core import InitErrorDetails, PydanticCustomError
+
+    error = PydanticCustomError("scenario", message.replace("{", "{{").replace("}", "}}"))
+    return ValidationError.from_exception_data(
+        "scenario", [InitErrorDetails(type=error, loc=loc, input=value)]
+    )
+
+
+class StrictModel(BaseModel):
+    """Base of every scenario schema: unknown keys are errors, values are frozen."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+class Units(StrictModel):
+    """Units in which a scenario states lengths and angles (converted to SI on load)."""
+
+    length: Literal["m", "mm", "in"] = Field("m", description="Length unit of the file.")
+    angle: Literal["rad", "deg"] = Field("rad", description="Angle unit of the file.")
+
+
+class RobotRef(StrictModel):
+    """Which robot: a built-in name, or a URDF file with its tool frame."""
+
+    name: str | None = Field(None, description="Built-in robot name (default: al5).")
+    urdf: str | None = Field(None, description="URDF path (relative to the working directory).")
+    tool: str | None = Field(None, description="Tool frame name of the URDF.")
+
+    @model_validator(mode="after")
+    def _name_or_urdf(self) -> RobotRef:
+        if self.name is not None and self.urdf is not None:
+            raise ValueError("give name or urdf, not both")
+        if self.tool is not None and self.urdf is None and self.name is None:
+            raise ValueError("tool needs name or urdf")
+        return self
+
+
+class ScenarioModel(StrictModel):
+    """Base of every kind's input model.
+
+    Class variables:
+        metrics: Metric name -> quantity, for every metric the kind's ``run`` reports. The
+            ``expect:`` block may only name these (``name``, or ``max_name`` / ``min_name``).
+        default_expect: Expectations checked even when the file does not name them.
+    """
+
+    metrics: ClassVar[Mapping[str, Quantity]] = {}
+    default_expect: ClassVar[Mapping[str, Any]] = {}
+
+    kind: str
+    name: str = Field("", description="Free-form name, used in summaries and file names.")
+    description: str = ""
+    units: Units = Field(default_factory=Units)
+    expect: dict[str, Any] = Field(
+        default_factory=dict,
+        description="Checks on the metrics: true/false, '<op> <number> [unit]', a bare number "
+        "for max_*/min_* keys, a list of names (each flag true), or {equals, tolerance}.",
+    )
+
+    @model_validator(mode="after")
+    def _expectations_parse(self) -> ScenarioModel:
+        from lynxplan.scenarios.expect import parse_expectations
+
+        parse_expectations(self.expect, type(self).metrics, self.units)
+        return self
+
+    def si_inputs(self) -> dict[str, Any]:
+        """The inputs echoed in ``report.json``, normalised to SI (m, rad, s).
+
+        The default echoes the file's values with its ``units``; kinds whose inputs carry
+        lengths or angles override it.
+        """
+        return self.model_dump(mode="json", by_alias=True, exclude={"expect"})
+
+
+def scaled(value: Any, factor: float) -> Any:
+    """``value`` (a number or nested lists of numbers; None passes) times ``factor``."""
+    if value is None or isinstance(value, bool):
+        return value
+    if isinstance(value, (list, tuple)):
+        return [scaled(v, factor) for v in value]
+    if isinstance(value, (int, float)):
+        return value * factor
+    return value
+
+
+def scale_translation(pose: Any, factor: float) -> Any:
+    """Rows of a 3x4 / 4x4 pose with the translation column times ``factor``."""
+    if pose is None:
+        return None
+    return [[*row[:3], row[3] * factor] if i < 3 else list(row) for i, row in enumerate(pose)]
+
+
+SI_UNITS = {"length": "m", "angle": "rad"}
+
+
+@dataclass(frozen=True)
+class KindOutput:
+    """What a kind's ``run`` computed.
+
+    Attributes:
+        metrics: Metric name -> value in SI units (float, bool, int, a list of floats, or for
+            ``flags`` a mapping name -> bool). Names must be declared in ``Input.metrics``.
+        summary: One paragraph for stdout.
+        details: Kind-specific tables for ``report.json`` (JSON-able, SI units).
+        payload: In-memory results ``write_outputs`` needs (not serialised).
+        stage_seconds: Wall time of each stage of the run, in [s].
+        notes: Metric name -> a line explaining its value (appended to a failed expectation's
+            message, e.g. where the first contact happened).
+    """
+
+    metrics: Mapping[str, Any]
+    summary: str
+    details: Mapping[str, Any] = field(default_factory=dict)
+    payload: Any = None
+    stage_seconds: Mapping[str, float] = field(default_factory=dict)
+    notes: Mapping[str, str] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class ExpectationResult:
+    """One ``expect:`` entry checked against a metric.
+
+    Attributes:
+        name: The key as written in ``expect:``.
+        wanted: The expectation as written (e.g. ``">= 0.2 in"``).
+        got: The measured value, in SI units (None for a value that is not a number).
+        passed: Whether it held.
+        message: A line saying what was measured against what was wanted.
+    """
+
+    name: str
+    wanted: Any
+    got: Any
+    passed: bool
+    message: str
+
+
+@dataclass(frozen=True)
+class Result:
+    """The result of one scenario run: what ``report.json`` holds.
+
+    Attributes:
+        kind: The scenario kind.
+        schema_version: :data:`SCHEMA_VERSION`.
+        name: The scenario's name.
+        inputs: The scenario echoed, normalised to SI.
+        metrics: Measured values, SI units.
+        expectations: Each ``expect:`` entry, checked.
+        artifacts: Files written next to ``report.json``, relative paths.
+        timing: Wall time of each stage and in total, in [s].
+        details: Kind-specific tables (SI units).
+        summary: One paragraph for stdout.
+    """
+
+    kind: str
+    schema_version: int
+    name: str
+    inputs: Mapping[str, Any]
+    metrics: Mapping[str, Any]
+    expectations: tuple[ExpectationResult, ...]
+    artifacts: tuple[str, ...]
+    timing: Mapping[str, float]
+    details: Mapping[str, Any]
+    summary: str
+
+    @property
+    def ok(self) -> bool:
+        """True when every expectation held."""
+        return all(e.passed for e in self.expectations)
+
+    @property
+    def failed_expectations(self) -> tuple[str, ...]:
+        """Messages of the expectations that did not hold."""
+        return tuple(e.message for e in self.expectations if not e.passed)
+
+
+class ScenarioKind(Protocol):
+    """Interface of a scenario-kind module."""
+
+    NAME: str
+    Input: type[ScenarioModel]
+
+    def run(self, scenario: Any) -> KindOutput: ...
+
+    def write_outputs(
+        self, scenario: Any, output: KindOutput, out_dir: Path, *, quick: bool
+    ) -> list[str]: ...

@@ -1,0 +1,168 @@
+"""Load, validate and run a scenario through the registry; check expectations; write outputs.
+
+This is the one path every front end takes: ``lynxplan run``, the pytest plugin, the service and
+:func:`lynxplan.run_scenario`.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+from typing import Any
+
+from pydantic import ValidationError
+
+from lynxplan.exceptions import LynxplanError, ScenarioError, ScenarioValueError
+from lynxplan.scenarios.base import (
+    SCHEMA_VERSION,
+    ExpectationResult,
+    KindOutput,
+    Result,
+    ScenarioKind,
+    ScenarioModel,
+)
+from lynxplan.scenarios.expect import evaluate, parse_expectations
+from lynxplan.scenarios.registry import kind_module
+from lynxplan.scenarios.source import ScenarioSource, format_location, read_source
+
+
+@dataclass(frozen=True)
+class LoadedScenario:
+    """A validated scenario and the kind module that runs it.
+
+    Attributes:
+        kind: The kind module.
+        scenario: The validated, frozen input model.
+        origin: File path or ``<mapping>``.
+        source: The raw source (for the line numbers of run-time errors).
+    """
+
+    kind: ScenarioKind
+    scenario: ScenarioModel
+    origin: str
+    source: ScenarioSource | None = None
+
+    def located(self, exc: ScenarioValueError) -> ScenarioError:
+        """A run-time scenario problem as a ScenarioError naming the file, key path and line."""
+        if self.source is not None:
+            return self.source.error(exc.loc, exc.reason)
+        return ScenarioError(self.origin, format_location(exc.loc), exc.reason)
+
+
+def validate(source: ScenarioSource) -> LoadedScenario:
+    """Validate raw scenario data (no computation).
+
+    Raises:
+        ScenarioError: naming the origin, the key path with its line, and the reason.
+    """
+    module = kind_module(source.data.get("kind"), source.origin)
+    try:
+        scenario = module.Input.model_validate(source.data)
+    except ValidationError as exc:
+        first = exc.errors()[0]
+        message = first["msg"].removeprefix("Value error, ")
+        raise source.error(tuple(first["loc"]), message) from None
+    return LoadedScenario(module, scenario, source.origin, source)
+
+
+def load_scenario(source: str | Path | Mapping[str, Any]) -> LoadedScenario:
+    """Read and validate a scenario file or mapping (no computation).
+
+    Raises:
+        ScenarioError: naming the file, the key path (and line) and the reason.
+    """
+    return validate(read_source(source))
+
+
+def check_expectations(
+    scenario: ScenarioModel, output: KindOutput
+) -> tuple[ExpectationResult, ...]:
+    """Evaluate the kind's default expectations and the file's ``expect:`` block."""
+    block = {**type(scenario).default_expect, **scenario.expect}
+    parsed = parse_expectations(block, type(scenario).metrics, scenario.units)
+    results = []
+    for item in parsed:
+        if item.metric not in output.metrics:
+            message = f"{item.key}: metric {item.metric!r} was not measured by this run"
+            results.append(ExpectationResult(item.key, item.text, None, False, message))
+        else:
+            checked = evaluate(item, output.metrics[item.metric], scenario.units)
+            note = output.notes.get(item.metric)
+            if note and not checked.passed:
+                checked = replace(checked, message=f"{checked.message} ({note})")
+            results.append(checked)
+    return tuple(results)
+
+
+def execute(
+    loaded: LoadedScenario,
+    out_dir: str | Path | None = None,
+    *,
+    quick: bool = False,
+    force: bool = False,
+) -> Result:
+    """Run a loaded scenario; write its outputs (all or nothing) into ``out_dir`` if given."""
+    from lynxplan.scenarios.outputs import staged_outputs
+    from lynxplan.scenarios.report import write_json
+
+    start = time.perf_counter()
+    try:
+        output = loaded.kind.run(loaded.scenario)
+    except ScenarioError:
+        raise
+    except ScenarioValueError as exc:
+        raise loaded.located(exc) from exc
+    except LynxplanError as exc:  # a run-time problem: say which file it came from
+        raise ScenarioError(loaded.origin, "", str(exc)) from exc
+    expectations = check_expectations(loaded.scenario, output)
+    timing = {**output.stage_seconds, "run": time.perf_counter() - start}
+
+    def result(artifacts: tuple[str, ...]) -> Result:
+        return Result(
+            kind=loaded.scenario.kind,
+            schema_version=SCHEMA_VERSION,
+            name=loaded.scenario.name,
+            inputs=loaded.scenario.si_inputs(),
+            metrics=dict(output.metrics),
+            expectations=expectations,
+            artifacts=artifacts,
+            timing={**timing, "total": time.perf_counter() - start},
+            details=dict(output.details),
+            summary=output.summary,
+        )
+
+    if out_dir is None:
+        return result(())
+    from lynxplan.scenarios.report import result_dict
+
+    with staged_outputs(out_dir, force=force) as staging:
+        written = loaded.kind.write_outputs(loaded.scenario, output, staging, quick=quick)
+        final = result(tuple(sorted({*written, "report.json"})))
+        write_json(staging / "report.json", result_dict(final))
+    return final
+
+
+def run_scenario(
+    source: str | Path | Mapping[str, Any],
+    out_dir: str | Path | None = None,
+    *,
+    quick: bool = False,
+    force: bool = False,
+) -> Result:
+    """Load, validate and run a scenario; write its outputs into ``out_dir`` if given.
+
+    Args:
+        source: Scenario YAML file, or the scenario as a mapping.
+        out_dir: Output folder (replaced as a whole by a complete run), or None to write nothing.
+        quick: Skip slow outputs (plots, HTML).
+        force: Replace ``out_dir`` even if it holds files lynxplan did not write.
+
+    Returns:
+        The run's :class:`Result`; ``result.ok`` tells whether every expectation held.
+
+    Raises:
+        ScenarioError: the scenario is invalid or cannot run (file, key path, reason).
+    """
+    return execute(load_scenario(source), out_dir, quick=quick, force=force)

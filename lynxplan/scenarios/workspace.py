@@ -1,0 +1,118 @@
+"""Scenario kind ``workspace``: sample the arm's workspace; volume, reach, plots, HTML.
+
+Example (``scenarios/workspace.yaml``)::
+
+    kind: workspace
+    units: {length: in, angle: deg}
+    samples: 2000000          # random configurations
+    cell: 0.04                # planar (r, z) grid cell, in the file's length unit
+    voxel_size: 0.4           # voxel edge of the voxel-count cross-check
+    expect: {max_reach: 16.5, min_volume: 9000}
+
+Metrics: ``volume`` [m^3] (revolution of the (r, z) region), ``volume_voxels`` [m^3],
+``reach`` [m] (largest sampled distance from the shoulder), ``z_min``/``z_max`` [m].
+Artifacts: ``workspace.json`` and, unless quick, ``workspace_*.png`` and ``workspace.html``.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any, ClassVar, Literal
+
+from pydantic import Field
+
+from lynxplan.scenarios.base import KindOutput, Quantity, RobotRef, ScenarioModel, Units
+from lynxplan.units import length_factor
+
+NAME = "workspace"
+
+#: Largest number of random samples a scenario may ask for (about 16 bytes x 3 each).
+MAX_SAMPLES = 50_000_000
+
+
+class Input(ScenarioModel):
+    """Workspace analysis of the arm (SPEC Part 1, Workspace)."""
+
+    metrics: ClassVar[dict[str, Quantity]] = {
+        "volume": "volume",
+        "volume_voxels": "volume",
+        "reach": "length",
+        "z_min": "length",
+        "z_max": "length",
+    }
+
+    kind: Literal["workspace"]
+    name: str = "workspace"
+    units: Units = Units(length="in", angle="deg")
+    robot: RobotRef = Field(default_factory=RobotRef)
+    samples: int = Field(2_000_000, ge=1, le=MAX_SAMPLES, description="Random configurations.")
+    voxel_size: float = Field(0.4, gt=0, allow_inf_nan=False, description="Voxel edge.")
+    cell: float = Field(0.04, gt=0, allow_inf_nan=False, description="Planar grid cell.")
+    seed: int = Field(0, ge=0, lt=2**63)
+    report_grid: bool = Field(True, description="Also sample the report's grid (plots use it).")
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Inputs with lengths in [m]."""
+        scale = length_factor(self.units.length)
+        data = super().si_inputs()
+        data.update(voxel_size=self.voxel_size * scale, cell=self.cell * scale)
+        data["units"] = {"length": "m", "angle": "rad"}
+        return data
+
+
+def run(scenario: Input) -> KindOutput:
+    """Sample the workspace and measure it (no files)."""
+    from lynxplan.arm.workspace import estimate_workspace, report_grid, tool_positions
+    from lynxplan.progress import progress_bar
+    from lynxplan.scenarios.robot import load_arm_robot
+
+    arm = load_arm_robot(scenario.robot)
+    unit = scenario.units.length
+    scale = length_factor(unit)
+    with progress_bar("sampling workspace") as progress:
+        estimate = estimate_workspace(
+            arm.geometry,
+            arm.limits,
+            samples=scenario.samples,
+            voxel_size=scenario.voxel_size * scale,
+            cell=scenario.cell * scale,
+            seed=scenario.seed,
+            progress=progress,
+        )
+    grid = tool_positions(report_grid(arm.limits), arm.geometry) if scenario.report_grid else None
+    metrics = {
+        "volume": estimate.volume_revolution,
+        "volume_voxels": estimate.volume_voxels,
+        "reach": estimate.max_reach,
+        "z_min": estimate.z_range[0],
+        "z_max": estimate.z_range[1],
+    }
+    summary = (
+        f"workspace of {arm.urdf_path.name}: {estimate.samples:,} samples, volume "
+        f"{estimate.volume_revolution / scale**3:.4g} {unit}^3 (voxel estimate "
+        f"{estimate.volume_voxels / scale**3:.4g} {unit}^3), max reach "
+        f"{estimate.max_reach / scale:.4f} {unit}, z from {estimate.z_range[0] / scale:.3f} to "
+        f"{estimate.z_range[1] / scale:.3f} {unit}."
+    )
+    details = {
+        "samples": estimate.samples,
+        "grid_cell": estimate.envelope.cell,
+        "voxel_size": estimate.voxel_size,
+        "report_grid_points": None if grid is None else int(grid.shape[0]),
+    }
+    return KindOutput(metrics, summary, details, payload=(estimate, grid))
+
+
+def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
+    """``workspace.json`` (in the file's unit) and, unless quick, the plots and the HTML view."""
+    from lynxplan.arm.workspace_report import plot_workspace, workspace_summary, write_html
+    from lynxplan.scenarios.report import write_json
+
+    estimate, grid = output.payload
+    unit = scenario.units.length
+    write_json(out_dir / "workspace.json", workspace_summary(estimate, grid, unit))
+    if quick:
+        return ["workspace.json"]
+    paths = plot_workspace(estimate, grid, out_dir, unit)
+    write_html(estimate.positions, out_dir / "workspace.html", unit)
+    return ["workspace.json", "workspace.html", *(p.name for p in paths)]

@@ -1,0 +1,179 @@
+"""The computations behind the routes, on validated numpy arrays; no HTTP here.
+
+They are plain functions of arrays so that a Dask worker can run them too
+(:func:`ik_batch_arrays` for large batches).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+
+#: Configurations cross-checked against Pinocchio's own FK in one /fk answer (a fixed subsample).
+FK_VERIFICATION_SAMPLES = 256
+
+
+def fk_arrays(arm: Any, q: np.ndarray) -> dict[str, Any]:
+    """Tool poses of ``q`` (5,) or (N, 5) [rad] and the verification residual.
+
+    Returns:
+        ``T``: (4, 4) or (N, 4, 4) in [m]; ``residual``: largest |closed form - Pinocchio| over
+        up to :data:`FK_VERIFICATION_SAMPLES` evenly spaced configurations, in [m] (unitless for
+        the rotation part).
+    """
+    T = arm.fk(q)
+    configs = q.reshape(-1, 5)
+    poses = T.reshape(-1, 4, 4)
+    picks = np.unique(
+        np.linspace(0, len(configs) - 1, min(len(configs), FK_VERIFICATION_SAMPLES)).astype(np.intp)
+    )
+    residual = max(
+        float(np.abs(arm.frame_placement(configs[i]) - poses[i]).max()) for i in picks.tolist()
+    )
+    return {"T": T, "residual": residual}
+
+
+def ik_single(
+    arm: Any, T: np.ndarray, q_reference: np.ndarray | None, select: str, approach_only: bool
+) -> tuple[Any, float]:
+    """IK of one pose (:meth:`Arm.ik`) and the tool position residual of the selected branch.
+
+    Returns:
+        The library's ``IkResult`` and ``|p_fk(q) - p_target|`` of the selected solution, in [m]
+        (NaN when no branch is within limits).
+    """
+    result = arm.ik(T, q_reference=q_reference, select=select, approach_only=approach_only)
+    if result.selected is None:
+        return result, float("nan")
+    reached = arm.fk(result.solutions[result.selected].q)
+    return result, float(np.linalg.norm(reached[:3, 3] - T[:3, 3]))
+
+
+def ik_batch_arrays(
+    T: np.ndarray, q_reference: np.ndarray | None = None, approach_only: bool = False
+) -> dict[str, np.ndarray]:
+    """All-branch IK of (N, 4, 4) poses with each branch's FK position residual.
+
+    Returns:
+        The fields of the library's ``IkBatch`` plus ``position_error`` (N, 4), in [m]:
+        ``|p_fk(q) - p_target|`` of every branch (NaN where the pose failed).
+    """
+    from lynxplan.arm.model import load_arm
+
+    arm = load_arm()
+    batch = arm.ik_batch(T, q_reference=q_reference, approach_only=approach_only)
+    q = batch.q.reshape(-1, 5)
+    failed = ~np.isfinite(q).all(axis=1)
+    reached = arm.fk(np.where(failed[:, None], 0.0, q))[:, :3, 3].reshape(-1, 4, 3)
+    error = np.linalg.norm(reached - T.reshape(-1, 4, 4)[:, None, :3, 3], axis=2)
+    error[failed.reshape(-1, 4)] = np.nan
+    out = {name: np.asarray(getattr(batch, name)) for name in batch._fields}
+    out["position_error"] = error
+    return out
+
+
+def build_obstacles(specs: Sequence[Mapping[str, Any]]) -> list[Any]:
+    """Obstacles from JSON objects ``{type: box|sphere|cylinder, name, centre, ...}`` in [m].
+
+    Raises:
+        KeyError, TypeError: a missing or misspelt key (the caller names the entry).
+        lynxplan.exceptions.InputError: bad values.
+    """
+    from lynxplan.collision import BoxObstacle, CylinderObstacle, SphereObstacle
+
+    kinds: dict[str, Any] = {
+        "box": BoxObstacle,
+        "sphere": SphereObstacle,
+        "cylinder": CylinderObstacle,
+    }
+    obstacles = []
+    for i, spec in enumerate(specs):
+        fields = dict(spec)
+        kind = fields.pop("type", None)
+        if kind not in kinds:
+            raise KeyError(f"obstacles[{i}].type must be one of box, sphere, cylinder")
+        fields.setdefault("name", f"{kind}_{i}")
+        obstacles.append(kinds[kind](**fields))
+    return obstacles
+
+
+def check_arrays(
+    arm: Any,
+    q: np.ndarray,
+    t: np.ndarray | None,
+    obstacles: list[Any],
+    self_collision: bool,
+) -> dict[str, Any]:
+    """Joint-limit and collision check of configurations (N, 5), or of a trajectory with times.
+
+    Without ``t``: the clearance of every configuration to every obstacle. With ``t`` (N,)
+    strictly increasing [s]: :func:`lynxplan.collision.check_trajectory` (between samples too).
+    """
+    from lynxplan.collision import CollisionWorld, check_trajectory, clearance_profile
+
+    configs = q.reshape(-1, 5)
+    lower, upper = arm.limits.lower, arm.limits.upper
+    within = ((configs >= lower) & (configs <= upper)).all(axis=1)
+    world = CollisionWorld(arm, obstacles, self_collision=self_collision)
+    out: dict[str, Any] = {"within_limits": within, "all_within_limits": bool(within.all())}
+    if t is None:
+        clearance = (
+            clearance_profile(world, configs) if obstacles else np.full((len(configs), 0), np.inf)
+        )
+        per_config = clearance.min(axis=1) if clearance.shape[1] else np.full(len(configs), np.inf)
+        out.update(
+            clearance=clearance,
+            min_clearance=per_config,
+            collision_free=bool((per_config > 0).all()),
+            obstacles=[o.name for o in obstacles],
+        )
+        return out
+    report = check_trajectory(world, configs, t)
+    out.update(
+        collision_free=report.collision_free,
+        certified=report.certified,
+        min_clearance=report.min_clearance._asdict(),
+        segments=[record._asdict() for record in report.segments],
+        segment_ids=list(report.segment_ids),
+        contacts=[c._asdict() for c in report.contacts],
+        refined_intervals=report.refined_intervals,
+        exact_queries=report.exact_queries,
+    )
+    return out
+
+
+def trajectory_profiles(
+    arm: Any,
+    waypoints: np.ndarray,
+    method: str,
+    rate: float,
+    limits: Any,
+    timing: tuple[float, float] | None,
+) -> list[Any]:
+    """Time-parameterise free (joint-space) motions through ``waypoints`` (M, 5) [rad].
+
+    Args:
+        method: ``"lspb"`` (``timing`` (tt, ta) [s] per segment, or the shortest LSPB within
+            ``limits`` when None), ``"ruckig"`` or ``"toppra"``.
+        rate: Sample rate, in [Hz].
+        limits: :class:`lynxplan.trajectory.MotionLimits`.
+
+    Returns:
+        One library ``Profile`` per segment (M - 1).
+    """
+    from lynxplan.trajectory import LspbTiming, free_segment, ruckig_profile, toppra_profile
+    from lynxplan.trajectory.retime import lspb_profile
+
+    profiles = []
+    for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
+        fixed = LspbTiming(*timing) if timing is not None and method == "lspb" else None
+        segment = free_segment(a, b, fixed, limits=limits)
+        if method == "lspb":
+            profiles.append(lspb_profile(segment, segment.timing, rate))
+        elif method == "ruckig":
+            profiles.append(ruckig_profile(a, b, limits, rate))
+        else:
+            profiles.append(toppra_profile(segment, limits, rate))
+    return profiles

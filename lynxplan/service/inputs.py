@@ -1,0 +1,143 @@
+"""Decoding of request fields into validated values (Problem 422/413 naming the field)."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from lynxplan.service.problems import Problem
+from lynxplan.service.wire import as_array
+
+#: Default robot when a request names none.
+DEFAULT_ROBOT = "al5"
+
+
+def robot_name(body: dict[str, Any]) -> str:
+    """The ``robot`` field (default ``al5``)."""
+    name = body.get("robot", DEFAULT_ROBOT)
+    if not isinstance(name, str):
+        raise Problem(422, f"robot must be a string. Got: {type(name).__name__}", "robot")
+    return name
+
+
+def flag(body: dict[str, Any], name: str, default: bool = False) -> bool:
+    """A boolean field."""
+    value = body.get(name, default)
+    if not isinstance(value, bool):
+        raise Problem(422, f"{name} must be true or false. Got: {value!r}"[:120], name)
+    return value
+
+
+def choice(body: dict[str, Any], name: str, options: tuple[str, ...]) -> str:
+    """A string field among ``options`` (default: the first)."""
+    value = body.get(name, options[0])
+    if value not in options:
+        raise Problem(
+            422, f"{name} must be one of {', '.join(options)}. Got: {value!r}"[:160], name
+        )
+    return str(value)
+
+
+def number(body: dict[str, Any], name: str, default: float, low: float, high: float) -> float:
+    """A finite number field within [low, high]."""
+    value = body.get(name, default)
+    if isinstance(value, bool) or not isinstance(value, int | float) or not math.isfinite(value):
+        raise Problem(422, f"{name} must be a number. Got: {value!r}"[:120], name)
+    if not low <= value <= high:
+        raise Problem(422, f"{name} must be within [{low:g}, {high:g}]. Got: {value:g}", name)
+    return float(value)
+
+
+def reference(body: dict[str, Any], count: int | None) -> np.ndarray | None:
+    """``q_reference``: (5,) or, for a batch of ``count`` poses, (count, 5), in [rad]."""
+    if body.get("q_reference") is None:
+        return None
+    array = as_array(body["q_reference"], "q_reference", (5,), batch=count is not None)
+    if array.ndim == 2 and array.shape[0] != count:
+        raise Problem(
+            422,
+            f"q_reference must have shape (5,) or ({count}, 5). Got: {array.shape}",
+            "q_reference",
+        )
+    return array
+
+
+def pose_from_position_approach(position: np.ndarray, approach: np.ndarray) -> np.ndarray:
+    """Poses (N, 4, 4) whose third rotation column is the unit ``approach`` (N, 3) at
+    ``position`` (N, 3) [m] (a 5-D target: the other two columns are any orthonormal pair)."""
+    norm = np.linalg.norm(approach, axis=1)
+    if (norm == 0).any():
+        raise Problem(422, "approach must not be a zero vector", "approach")
+    z = approach / norm[:, None]
+    helper = np.where((np.abs(z[:, 0]) < 0.9)[:, None], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    x = np.cross(helper, z)
+    x /= np.linalg.norm(x, axis=1)[:, None]
+    T = np.zeros((len(z), 4, 4))
+    T[:, :3, 0], T[:, :3, 1], T[:, :3, 2] = x, np.cross(z, x), z
+    T[:, :3, 3], T[:, 3, 3] = position, 1.0
+    return T
+
+
+def ik_target(body: dict[str, Any], limit: int) -> tuple[np.ndarray, bool, bool]:
+    """Target poses of an /ik JSON body: ``T`` (4, 4) / (N, 4, 4), or ``position`` + ``approach``
+    ((3,) / (N, 3), a 5-D target). Returns (poses, batch?, approach_only?)."""
+    if "T" in body:
+        T = as_array(body["T"], "T", (4, 4), limit=limit)
+        return T, T.ndim == 3, flag(body, "approach_only")
+    if "position" in body and "approach" in body:
+        position = as_array(body["position"], "position", (3,), limit=limit)
+        approach = as_array(body["approach"], "approach", (3,), limit=limit)
+        if position.shape != approach.shape:
+            raise Problem(
+                422,
+                f"approach must have the shape of position {position.shape}. Got: {approach.shape}",
+                "approach",
+            )
+        poses = pose_from_position_approach(position.reshape(-1, 3), approach.reshape(-1, 3))
+        return (poses, True, True) if position.ndim == 2 else (poses[0], False, True)
+    raise Problem(422, "give the target as T (4x4 pose) or as position and approach", "T")
+
+
+def obstacle_specs(body: dict[str, Any]) -> list[dict[str, Any]]:
+    """The ``obstacles`` list of objects."""
+    specs = body.get("obstacles", [])
+    if not isinstance(specs, list) or not all(isinstance(s, dict) for s in specs):
+        raise Problem(422, "obstacles must be a list of objects", "obstacles")
+    return specs
+
+
+def motion_limits(body: dict[str, Any], arm: Any) -> Any:
+    """``limits: {velocity, acceleration, jerk}`` (each a number or 5 numbers, SI) over the
+    robot's URDF limits and the library defaults."""
+    from lynxplan.trajectory import MotionLimits
+
+    given = body.get("limits") or {}
+    if not isinstance(given, dict):
+        raise Problem(422, "limits must be an object", "limits")
+    unknown = set(given) - {"velocity", "acceleration", "jerk"}
+    if unknown:
+        raise Problem(
+            422,
+            f"unknown limit {sorted(unknown)[0]!r}; limits: velocity, acceleration, jerk",
+            f"limits.{sorted(unknown)[0]}",
+        )
+    values: dict[str, Any] = {}
+    for name, value in given.items():
+        array = (
+            as_array(value, f"limits.{name}", (5,))
+            if isinstance(value, list)
+            else as_array(value, f"limits.{name}", ())
+        )
+        if (array <= 0).any():
+            raise Problem(422, f"limits.{name} must be positive", f"limits.{name}")
+        values[name] = array
+    base = MotionLimits.from_joint_limits(arm.limits)
+    velocity = values.get("velocity", base.velocity)
+    return MotionLimits(
+        base.position,
+        velocity,
+        values.get("acceleration", base.acceleration),
+        values.get("jerk", base.jerk),
+    )

@@ -1,0 +1,182 @@
+"""Request and response encodings: JSON (orjson) for small payloads, binary arrays for large ones.
+
+Binary requests carry one array, either as ``application/x-npy`` (a ``.npy`` file, never pickled)
+or as ``application/octet-stream`` raw little-endian float64 with its shape in the ``X-Shape``
+header (``"100000,4,4"``). Binary responses are ``application/x-npz``: one ``.npy`` member per
+result array. Arrays are checked for dtype, shape and finiteness with numpy, never element by
+element, and JSON answers serialise numpy arrays directly (``OPT_SERIALIZE_NUMPY``).
+"""
+
+from __future__ import annotations
+
+import io
+import zipfile
+from collections.abc import Mapping
+from typing import Any
+
+import numpy as np
+import orjson
+from starlette.requests import Request
+from starlette.responses import Response
+
+from lynxplan.service.problems import Problem
+
+NPY_MEDIA_TYPE = "application/x-npy"
+NPZ_MEDIA_TYPE = "application/x-npz"
+RAW_MEDIA_TYPE = "application/octet-stream"
+JSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY
+
+
+async def read_body(request: Request, limit: int) -> bytes:
+    """The request body; Problem 413 as soon as it exceeds ``limit`` bytes."""
+    declared = request.headers.get("content-length")
+    if declared is not None and declared.isdigit() and int(declared) > limit:
+        raise Problem(413, f"request body of {int(declared)} bytes exceeds the limit of {limit}")
+    chunks: list[bytes] = []
+    size = 0
+    async for chunk in request.stream():
+        size += len(chunk)
+        if size > limit:
+            raise Problem(413, f"request body exceeds the limit of {limit} bytes")
+        chunks.append(chunk)
+    return b"".join(chunks)
+
+
+def media_type(request: Request) -> str:
+    """The request's media type without parameters, lower case (``application/json`` default)."""
+    raw = request.headers.get("content-type", "application/json")
+    return raw.split(";", 1)[0].strip().lower() or "application/json"
+
+
+def is_binary(request: Request) -> bool:
+    """Whether the body is a binary array (npy or raw float64)."""
+    return media_type(request) in (NPY_MEDIA_TYPE, RAW_MEDIA_TYPE)
+
+
+def wants_binary(request: Request) -> bool:
+    """Whether the client asked for an npz answer (``Accept: application/x-npz``)."""
+    return NPZ_MEDIA_TYPE in request.headers.get("accept", "")
+
+
+def parse_json_object(body: bytes) -> dict[str, Any]:
+    """A JSON object; Problem 422 for malformed JSON or another top-level type."""
+    if not body:
+        raise Problem(422, "the request body is empty; expected a JSON object", "body")
+    try:
+        value = orjson.loads(body)
+    except orjson.JSONDecodeError as exc:
+        raise Problem(422, f"malformed JSON: {exc}", "body") from None
+    if not isinstance(value, dict):
+        raise Problem(422, f"expected a JSON object. Got: {type(value).__name__}", "body")
+    return value
+
+
+def decode_binary(request: Request, body: bytes, field: str) -> np.ndarray:
+    """The array of a binary body (npy or raw float64 + ``X-Shape``), as float64."""
+    if media_type(request) == NPY_MEDIA_TYPE:
+        try:
+            array = np.load(io.BytesIO(body), allow_pickle=False)
+        except (ValueError, OSError, EOFError) as exc:
+            raise Problem(422, f"invalid .npy body: {exc}", field) from None
+        if not isinstance(array, np.ndarray) or array.dtype.kind not in "iuf":
+            raise Problem(422, f"the .npy array must be numeric. Got: {array.dtype}", field)
+        return np.ascontiguousarray(array, dtype=np.float64)
+    shape_header = request.headers.get("x-shape")
+    if shape_header is None:
+        raise Problem(422, "raw float64 bodies need an X-Shape header, e.g. '100,4,4'", "X-Shape")
+    try:
+        shape = tuple(int(part) for part in shape_header.split(","))
+    except ValueError:
+        raise Problem(
+            422, f"X-Shape must be integers separated by commas. Got: {shape_header!r}", "X-Shape"
+        ) from None
+    if any(n < 0 for n in shape) or len(body) != 8 * int(np.prod(shape, dtype=np.int64)):
+        raise Problem(
+            422, f"body of {len(body)} bytes does not hold float64 of shape {shape}", "X-Shape"
+        )
+    return np.frombuffer(body, dtype="<f8").reshape(shape)
+
+
+def as_array(
+    value: Any, field: str, trailing: tuple[int, ...], *, batch: bool = True, limit: int = 0
+) -> np.ndarray:
+    """A float64 array of shape ``trailing`` or (N, *trailing), checked with numpy.
+
+    Raises:
+        Problem: 422 for a wrong type, shape or a non-finite value; 413 for N > ``limit`` (> 0).
+    """
+    if isinstance(value, np.ndarray):
+        array = value
+    else:
+        try:
+            array = np.array(value)
+        except (ValueError, TypeError):
+            raise Problem(422, f"{field} must be a (nested) list of numbers", field) from None
+    if array.dtype.kind not in "iuf" or array.size == 0 and array.ndim == 0:
+        raise Problem(422, f"{field} must contain numbers only. Got: {_describe(value)}", field)
+    expected = str(trailing) if not batch else f"{trailing} or (N, {', '.join(map(str, trailing))})"
+    single = array.shape == trailing
+    if not single and not (
+        batch and array.ndim == len(trailing) + 1 and array.shape[1:] == trailing
+    ):
+        raise Problem(422, f"{field} must have shape {expected}. Got: {array.shape}", field)
+    if limit and not single and array.shape[0] > limit:
+        raise Problem(
+            413, f"{field}: batch of {array.shape[0]} exceeds the limit of {limit}", field
+        )
+    array = np.ascontiguousarray(array, dtype=np.float64)
+    finite = np.isfinite(array)
+    if not finite.all():
+        where = np.argwhere(~finite)[0].tolist()
+        raise Problem(
+            422, f"{field} contains NaN or infinite values (first at {where})", f"{field}{where}"
+        )
+    return array
+
+
+def _describe(value: Any) -> str:
+    text = orjson.dumps(value, default=str)[:60].decode(errors="replace")
+    return text
+
+
+def _default(value: Any) -> Any:
+    if isinstance(value, np.ndarray):  # a strided view: one contiguous copy, still no tolist()
+        return np.ascontiguousarray(value)
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"cannot serialise {type(value).__name__}")
+
+
+def dumps(content: Any) -> bytes:
+    """JSON bytes of ``content`` (numpy arrays natively, NaN and infinities as null)."""
+    return orjson.dumps(content, option=JSON_OPTIONS, default=_default)
+
+
+def json_response(content: Any, status: int = 200) -> Response:
+    """A JSON response serialised by orjson (numpy arrays natively, NaN as null)."""
+    return Response(dumps(content), status_code=status, media_type="application/json")
+
+
+def npz_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
+    """An uncompressed .npz archive of ``arrays`` (one .npy member each)."""
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", compression=zipfile.ZIP_STORED) as archive:
+        for name, array in arrays.items():
+            with archive.open(f"{name}.npy", "w", force_zip64=True) as member:
+                np.lib.format.write_array(member, np.ascontiguousarray(array), allow_pickle=False)
+    return buffer.getvalue()
+
+
+def npz_response(arrays: Mapping[str, np.ndarray], scalars: Mapping[str, Any]) -> Response:
+    """An npz answer; ``scalars`` travel as JSON in the ``X-Result`` header."""
+    return Response(
+        npz_bytes(arrays),
+        media_type=NPZ_MEDIA_TYPE,
+        headers={"X-Result": orjson.dumps(scalars).decode()},
+    )
+
+
+def read_npz(data: bytes) -> dict[str, np.ndarray]:
+    """Arrays of an npz answer (client side)."""
+    with np.load(io.BytesIO(data), allow_pickle=False) as archive:
+        return {name: archive[name] for name in archive.files}
