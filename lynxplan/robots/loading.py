@@ -144,7 +144,12 @@ def _lock_joints(xml: str, angles: dict[str, float]) -> str:
             origin = joint.find("origin")
             axis_el = joint.find("axis")
             axis = np.array(
-                [float(v) for v in ((axis_el.get("xyz") if axis_el is not None else None) or "1 0 0").split()]
+                [
+                    float(v)
+                    for v in (
+                        (axis_el.get("xyz") if axis_el is not None else None) or "1 0 0"
+                    ).split()
+                ]
             )
             rpy = [
                 float(v)

@@ -32,7 +32,9 @@ def _joint(
     )
 
 
-def random_family_urdf(rng: np.random.Generator, off_axis_tool: bool = True) -> str:
+def random_family_urdf(
+    rng: np.random.Generator, off_axis_tool: bool = True, approach_is_z: bool = False
+) -> str:
     """A yaw-pitch^3-roll arm with random lengths, offsets, signs, built-in angles, zeros, tool."""
     links = "".join(f'  <link name="l{i}"/>\n' for i in range(6)) + '  <link name="tool"/>\n'
     sign = lambda: float(rng.choice([-1.0, 1.0]))  # noqa: E731
@@ -92,6 +94,8 @@ def random_family_urdf(rng: np.random.Generator, off_axis_tool: bool = True) -> 
     if off_axis_tool:
         tool_xyz[1:] = rng.uniform(-0.012, 0.012, 2)
     rpy = rng.uniform(-math.pi, math.pi, 3)
+    if approach_is_z:  # tool z along the roll axis (x of l5), any angle about it
+        rpy = np.array([0.0, math.pi / 2, 0.0])
     joints += (
         '  <joint name="tool_joint" type="fixed">\n'
         '    <parent link="l5"/><child link="tool"/>\n'

@@ -26,18 +26,32 @@ DEFAULT_STARTS = 128
 
 @numba.njit(cache=True, nogil=True)
 def _error(pose: np.ndarray, target: np.ndarray, approach_only: bool, e: np.ndarray) -> None:
-    """Position error then orientation error (Siciliano: 0.5 sum n_i x n_t,i; approach: a x a_t)."""
+    """Position error then orientation error (Siciliano: 0.5 sum n_i x n_t,i; approach: a_t - a)."""
     for i in range(3):
         e[i] = target[i, 3] - pose[i, 3]
         e[3 + i] = 0.0
-    first = 2 if approach_only else 0
-    scale = 1.0 if approach_only else 0.5
-    for c in range(first, 3):
+    if approach_only:  # a_t - a, whose Jacobian is w x a (see _approach_rows)
+        for i in range(3):
+            e[3 + i] = target[i, 2] - pose[i, 2]
+        return
+    scale = 0.5
+    for c in range(3):
         u0, u1, u2 = pose[0, c], pose[1, c], pose[2, c]
         v0, v1, v2 = target[0, c], target[1, c], target[2, c]
         e[3] += scale * (u1 * v2 - u2 * v1)
         e[4] += scale * (u2 * v0 - u0 * v2)
         e[5] += scale * (u0 * v1 - u1 * v0)
+
+
+@numba.njit(cache=True, nogil=True)
+def _approach_rows(pose: np.ndarray, jac: np.ndarray) -> None:
+    """Angular rows w_i -> w_i x a: the rate of the approach axis a (tool z) per joint."""
+    a0, a1, a2 = pose[0, 2], pose[1, 2], pose[2, 2]
+    for i in range(jac.shape[1]):
+        w0, w1, w2 = jac[3, i], jac[4, i], jac[5, i]
+        jac[3, i] = w1 * a2 - w2 * a1
+        jac[4, i] = w2 * a0 - w0 * a2
+        jac[5, i] = w0 * a1 - w1 * a0
 
 
 @numba.njit(cache=True, nogil=True)
@@ -107,6 +121,8 @@ def numerical_ik_kernel(
                 q[j] = min(max(q[j], lower[j]), upper[j])
             lam = 1e-3
             chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
+            if approach_only:
+                _approach_rows(pose, jac)
             _error(pose, target, approach_only, e)
             cost = 0.0
             for i in range(6):
@@ -129,6 +145,8 @@ def numerical_ik_kernel(
                 for j in range(n):
                     q_new[j] = min(max(q[j] + step[j], lower[j]), upper[j])
                 chain_fk_jacobian(placements, axes, q_new, pose, jac, work, origins)
+                if approach_only:
+                    _approach_rows(pose, jac)
                 _error(pose, target, approach_only, e_new)
                 new_cost = 0.0
                 for i in range(6):
@@ -141,6 +159,8 @@ def numerical_ik_kernel(
                 else:
                     lam *= 4.0
                     chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
+                    if approach_only:
+                        _approach_rows(pose, jac)
                     if lam > 1e8:
                         break
             chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
