@@ -185,10 +185,15 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
         else:
             raise InputError("ik: --position needs --approach AX AY AZ or --pitch ANGLE")
         result = robot.ik(
-            position=position, approach=approach, pitch=pitch, roll=roll, q_reference=reference
+            position=position,
+            approach=approach,
+            pitch=pitch,
+            roll=roll,
+            q_reference=reference,
+            verify=True,
         )
     elif args.pose is not None:
-        result = robot.ik(parse_pose(args.pose, unit_length), q_reference=reference)
+        result = robot.ik(parse_pose(args.pose, unit_length), q_reference=reference, verify=True)
     else:
         raise InputError("ik: give --pose, or --position with --approach or --pitch")
     listed = [i for i, s in enumerate(result.solutions) if args.all or s.within_limits]

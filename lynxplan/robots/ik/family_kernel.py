@@ -139,16 +139,19 @@ def _best_roll(prm: np.ndarray, g: np.ndarray, phi: float, pitch_sum: float) -> 
     r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
     cy, sy = math.cos(-phi), math.sin(-phi)
     cp, sp = math.cos(-pitch_sum), math.sin(-pitch_sum)
-    m = np.empty((3, 3))
-    for j in range(3):
-        v0, v1, v2 = _rotate(k0, k1, k2, cy, sy, g[0, j], g[1, j], g[2, j])
-        v0, v1, v2 = _rotate(p0, p1, p2, cp, sp, v0, v1, v2)
-        m[0, j], m[1, j], m[2, j] = v0, v1, v2
-    sine = r0 * (m[2, 1] - m[1, 2]) + r1 * (m[0, 2] - m[2, 0]) + r2 * (m[1, 0] - m[0, 1])
-    rmr = 0.0
-    for i in range(3):
-        rmr += prm[F.R + i] * (m[i, 0] * r0 + m[i, 1] * r1 + m[i, 2] * r2)
-    return math.atan2(sine, m[0, 0] + m[1, 1] + m[2, 2] - rmr)
+    x0, x1, x2 = _rotate(k0, k1, k2, cy, sy, g[0, 0], g[1, 0], g[2, 0])
+    m00, m10, m20 = _rotate(p0, p1, p2, cp, sp, x0, x1, x2)
+    x0, x1, x2 = _rotate(k0, k1, k2, cy, sy, g[0, 1], g[1, 1], g[2, 1])
+    m01, m11, m21 = _rotate(p0, p1, p2, cp, sp, x0, x1, x2)
+    x0, x1, x2 = _rotate(k0, k1, k2, cy, sy, g[0, 2], g[1, 2], g[2, 2])
+    m02, m12, m22 = _rotate(p0, p1, p2, cp, sp, x0, x1, x2)
+    sine = r0 * (m21 - m12) + r1 * (m02 - m20) + r2 * (m10 - m01)
+    rmr = (
+        r0 * (m00 * r0 + m01 * r1 + m02 * r2)
+        + r1 * (m10 * r0 + m11 * r1 + m12 * r2)
+        + r2 * (m20 * r0 + m21 * r1 + m22 * r2)
+    )
+    return math.atan2(sine, m00 + m11 + m22 - rmr)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -344,6 +347,8 @@ def _roll_candidates(
     lo: float,
     hi: float,
     roots: np.ndarray,
+    xs: np.ndarray,
+    fs: np.ndarray,
 ) -> int:
     """Every root of the roll equation in [lo, hi] (at most MAX_ROOTS); returns their count.
 
@@ -355,9 +360,6 @@ def _roll_candidates(
     # uniform grid; cells where f changes fast are split SUBDIVISION times, and cells where
     # the yaw circle starts or stops being reachable are sampled towards that boundary with a
     # quadratic spacing (f behaves like the square root of the distance to it there)
-    size = ROOT_GRID * (BOUNDARY_SAMPLES + SUBDIVISION) + 2
-    xs = np.empty(size)
-    fs = np.empty(size)
     step = (hi - lo) / ROOT_GRID
     m = 0
     xs[0] = lo
@@ -560,29 +562,28 @@ def _conditions(
     for i in range(3):
         e[i] = pose[i, 3] - target[i, 3]
     # approach axis and pitch axis of the reached configuration
-    a = np.empty(3)
-    at = np.empty(3)
     rt = prm[F.RT0 : F.RT0 + 9]
     r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
     # approach in the tool frame: Rt0^T r
     u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
     u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
     u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
-    for i in range(3):
-        a[i] = pose[i, 0] * u0 + pose[i, 1] * u1 + pose[i, 2] * u2
+    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
+    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
+    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
     cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
     k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
     pp0, pp1, pp2 = _rotate(k0, k1, k2, cy, sy, prm[F.P], prm[F.P + 1], prm[F.P + 2])
     if mode == MODE_PITCH:
         h0, h1, h2 = _rotate(k0, k1, k2, cy, sy, prm[F.H], prm[F.H + 1], prm[F.H + 2])
         sp, cp = math.sin(pitch), math.cos(pitch)
-        at[0], at[1], at[2] = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
+        t0, t1, t2 = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
     else:
-        at[0], at[1], at[2] = g[0, 3], g[1, 3], g[2, 3]
+        t0, t1, t2 = g[0, 3], g[1, 3], g[2, 3]
     # in-plane approach angle matches: (a x at) . p = 0
-    c0 = a[1] * at[2] - a[2] * at[1]
-    c1 = a[2] * at[0] - a[0] * at[2]
-    c2 = a[0] * at[1] - a[1] * at[0]
+    c0 = a1 * t2 - a2 * t1
+    c1 = a2 * t0 - a0 * t2
+    c2 = a0 * t1 - a1 * t0
     e[3] = c0 * pp0 + c1 * pp1 + c2 * pp2
     if (
         not math.isnan(roll_given)
@@ -591,19 +592,17 @@ def _conditions(
     ):
         e[4] = q[4] - roll_given
     elif mode == MODE_APPROACH:  # the approach exactly: (a x at) . (a x p) = 0 as well
-        w0 = a[1] * pp2 - a[2] * pp1
-        w1 = a[2] * pp0 - a[0] * pp2
-        w2 = a[0] * pp1 - a[1] * pp0
+        w0 = a1 * pp2 - a2 * pp1
+        w1 = a2 * pp0 - a0 * pp2
+        w2 = a0 * pp1 - a1 * pp0
         e[4] = c0 * w0 + c1 * w1 + c2 * w2
     else:  # best roll about the approach axis: a . vee(Rt R^T - R Rt^T) = 0
-        v = 0.0
-        for i in range(3):
-            j, l = (i + 1) % 3, (i + 2) % 3
-            s = 0.0
-            for m in range(3):
-                s += target[l, m] * pose[j, m] - pose[l, m] * target[j, m]
-            v += a[i] * s
-        e[4] = v
+        v0 = v1 = v2 = 0.0
+        for m in range(3):
+            v0 += target[2, m] * pose[1, m] - pose[2, m] * target[1, m]
+            v1 += target[0, m] * pose[2, m] - pose[0, m] * target[2, m]
+            v2 += target[1, m] * pose[0, m] - pose[1, m] * target[0, m]
+        e[4] = a0 * v0 + a1 * v1 + a2 * v2
 
 
 @numba.njit(cache=True, nogil=True)
@@ -617,17 +616,19 @@ def _polish(
     pitch: float,
     roll_given: float,
     q: np.ndarray,
+    scratch: np.ndarray,
+    scratch4: np.ndarray,
+    scratch5: np.ndarray,
 ) -> float:
     """Newton's method on the five conditions, on the exact chain (finite-difference Jacobian).
 
     Keeps the closed-form answer when Newton does not reduce the conditions (unreachable).
     """
-    pose, work = np.empty((4, 4)), np.empty((4, 4))
-    e, e2 = np.empty(5), np.empty(5)
-    jac = np.empty((5, 5))
-    qh = np.empty(5)
-    start = q.copy()
-    qt = np.empty(5)
+    # scratch (7, 5): rows e, e2, qh, start, qt; (pose, work) in scratch4, jac in scratch5
+    pose, work = scratch4[0], scratch4[1]
+    e, e2, qh, start, qt = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
+    jac = scratch5
+    start[:] = q
     _conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
     first = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
     norm = first
@@ -766,6 +767,11 @@ def family_ik_kernel(
     roots = np.empty(2 * MAX_ROOTS)
     q = np.empty(5)
     trial = np.empty(5)
+    scratch = np.empty((5, 5))
+    scratch4 = np.empty((2, 4, 4))
+    scratch5 = np.empty((5, 5))
+    size = ROOT_GRID * (BOUNDARY_SAMPLES + SUBDIVISION) + 2
+    grid_x, grid_f = np.empty(size), np.empty(size)
     nearest = 0.0
     exact = prm[F.EXACT] != 0.0
     off_axis = prm[F.OFF_AXIS] != 0.0
@@ -805,7 +811,7 @@ def family_ik_kernel(
             rooted = True
             if need_roots:
                 count = _roll_candidates(
-                    prm, target, g, mode, side, phi_ref, sum_ref, lo5, hi5, roots
+                    prm, target, g, mode, side, phi_ref, sum_ref, lo5, hi5, roots, grid_x, grid_f
                 )
                 if count < 0:  # no root: the nearest roll, held during the polish
                     count, rooted = 1, False
@@ -825,7 +831,20 @@ def family_ik_kernel(
                     if need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
                         # a tentative root: a branch only if Newton converges on the exact model
                         if (
-                            _polish(prm, placements, axes, target, g, mode, pitch[n], np.nan, q)
+                            _polish(
+                                prm,
+                                placements,
+                                axes,
+                                target,
+                                g,
+                                mode,
+                                pitch[n],
+                                np.nan,
+                                q,
+                                scratch,
+                                scratch4,
+                                scratch5,
+                            )
                             >= _NEWTON_TOLERANCE
                         ):
                             continue
@@ -833,7 +852,20 @@ def family_ik_kernel(
                     elif not exact and not rooted:
                         trial[:] = q
                         if (
-                            _polish(prm, placements, axes, target, g, mode, pitch[n], np.nan, trial)
+                            _polish(
+                                prm,
+                                placements,
+                                axes,
+                                target,
+                                g,
+                                mode,
+                                pitch[n],
+                                np.nan,
+                                trial,
+                                scratch,
+                                scratch4,
+                                scratch5,
+                            )
                             < _NEWTON_TOLERANCE
                         ):
                             q[:] = trial
@@ -860,7 +892,20 @@ def family_ik_kernel(
                             or not rooted
                         ):
                             rg = q[4]
-                        _polish(prm, placements, axes, target, g, mode, pitch[n], rg, q)
+                        _polish(
+                            prm,
+                            placements,
+                            axes,
+                            target,
+                            g,
+                            mode,
+                            pitch[n],
+                            rg,
+                            q,
+                            scratch,
+                            scratch4,
+                            scratch5,
+                        )
                     inside = True
                     for j in range(5):
                         x, ok = _wrap_into_limits(q[j], lower[j], upper[j], tol)

@@ -44,12 +44,50 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
     assert family is not None
     n = target.poses.shape[0]
     slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
-    q = np.empty((n, slots, 5))
-    valid = np.empty((n, slots), dtype=np.bool_)
-    within = np.empty((n, slots), dtype=np.bool_)
-    perr = np.empty((n, slots))
-    oerr = np.empty((n, slots))
-    miss = np.empty((n, slots))
+    q = np.full((n, slots, 5), np.nan)
+    valid = np.zeros((n, slots), dtype=np.bool_)
+    within = np.zeros((n, slots), dtype=np.bool_)
+    perr = np.full((n, slots), np.nan)
+    oerr = np.full((n, slots), np.nan)
+    rest = np.ones(n, dtype=np.bool_)
+    if robot._arm is not None and target.kind != fk_.MODE_PITCH:
+        rest = ~_al5_fill(robot, target, reference, q, valid, within, perr, oerr)
+    if rest.all():
+        _kernel(robot, target, reference, q, valid, within, perr, oerr)
+    elif rest.any():
+        sub = type(target)(
+            np.ascontiguousarray(target.poses[rest]),
+            target.kind,
+            target.pitch[rest],
+            target.roll[rest],
+        )
+        ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[rest])
+        parts = [a[rest] for a in (q, valid, within, perr, oerr)]
+        _kernel(robot, sub, ref, *parts)
+        for whole, part in zip((q, valid, within, perr, oerr), parts, strict=True):
+            whole[rest] = part
+    distance = np.where(valid, perr, np.inf).min(axis=1)
+    reachable = distance <= REACH_TOLERANCE
+    # a reachable target's solutions are the branches that reach it; the others are dropped
+    valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
+    for array in (q, valid, within, perr, oerr, reachable, distance):
+        array.setflags(write=False)
+    return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
+
+
+def _kernel(
+    robot: Robot,
+    target: Target,
+    reference: np.ndarray,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> None:
+    family = robot.family
+    assert family is not None
+    miss = np.empty(valid.shape)
     fk_.family_ik_kernel(
         family.packed,
         robot.chain.placements,
@@ -66,27 +104,19 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         oerr,
         miss,
     )
-    if robot._arm is not None and target.kind != fk_.MODE_PITCH:
-        _al5_override(robot, target, reference, q, within, perr, oerr)
-    distance = np.where(valid, perr, np.inf).min(axis=1)
-    reachable = distance <= REACH_TOLERANCE
-    # a reachable target's solutions are the branches that reach it; the others are dropped
-    valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
-    for array in (q, valid, within, perr, oerr, reachable, distance):
-        array.setflags(write=False)
-    return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
 
 
-def _al5_override(
+def _al5_fill(
     robot: Robot,
     target: Target,
     reference: np.ndarray,
     q: np.ndarray,
+    valid: np.ndarray,
     within: np.ndarray,
     perr: np.ndarray,
     oerr: np.ndarray,
-) -> None:
-    """Reachable AL5 targets: the branches of lynxplan.arm (same numbers as before)."""
+) -> np.ndarray:
+    """Targets the AL5 kernels of lynxplan.arm solve (same numbers as before); returns which."""
     from lynxplan.arm.ik import IkStatus
 
     ref = np.broadcast_to(reference, (target.poses.shape[0], 5)).copy()
@@ -98,7 +128,8 @@ def _al5_override(
     )
     ok = np.asarray(batch.status) == IkStatus.OK
     if not ok.any():
-        return
+        return ok
+    valid[ok] = True
     q_arm = np.asarray(batch.q)[ok]
     poses = np.asarray(arm.fk(q_arm.reshape(-1, 5))).reshape(-1, 4, 4, 4)
     goal = target.poses[ok]
@@ -117,3 +148,4 @@ def _al5_override(
             axis=-1,
         )
         oerr[ok] = np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), 0.5 * (trace - 1.0))
+    return ok
