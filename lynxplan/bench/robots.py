@@ -77,9 +77,11 @@ def run(quick: bool) -> list[Figure]:
             ),
         ]
         single = robot.fk(robot.random_configurations(1, seed=2))[0]
-        seconds = median_seconds(
-            lambda r=robot, p=single: r.ik(p), repeats=5, number=200 if quick else 2000
-        )
+
+        def solve_one(r: object = robot, p: np.ndarray = single) -> object:
+            return r.ik(p)  # type: ignore[attr-defined]
+
+        seconds = median_seconds(solve_one, repeats=5, number=200 if quick else 2000)
         figures.append(
             Figure(
                 "robots",

@@ -340,6 +340,8 @@ class Robot:
         roll: float | None = None,
         q_reference: Any = None,
         verify: bool = False,
+        approach_only: bool = False,
+        select: str = "nearest",
     ) -> RobotIkResult:
         """IK of one target: every branch, verified, one selected (nearest the reference).
 
@@ -347,6 +349,11 @@ class Robot:
             pose: Target tool pose, shape (4, 4), [m]; or ``position`` (3,) [m] with
                 ``approach`` (3,) or ``pitch`` [rad]; ``roll`` [rad] fixes the roll joint.
             q_reference: Shape (n,), [rad]: configuration to stay near. Default: zeros.
+            approach_only: ``lynxplan.arm.Arm.ik`` compatibility: ``pose`` is a position (column
+                3) and an approach direction (column 2); the roll is ``roll``, else the roll of
+                ``q_reference`` (else free).
+            select: ``"nearest"`` (the only rule for every robot; the AL5's ``"report"`` rule
+                lives in ``lynxplan.arm``).
             verify: Also re-check each branch with Pinocchio's FK (adds ~5 us per branch). Every
                 branch is always verified by the solver's FK of the exact chain (the same
                 product of exponentials; equal to Pinocchio's to 1e-15 m in the tests).
@@ -356,6 +363,15 @@ class Robot:
         """
         if pose is not None and np.shape(pose) != (4, 4):
             raise ShapeError("pose", "(4, 4)", np.shape(pose))
+        if select != "nearest":
+            raise TargetError(f"select must be 'nearest' for a Robot. Got: {select!r}")
+        if approach_only:
+            if pose is None:
+                raise TargetError("approach_only needs a pose (position and approach columns)")
+            frame = np.asarray(pose, dtype=float)
+            if roll is None and q_reference is not None:
+                roll = float(np.asarray(q_reference, dtype=float).reshape(-1)[-1])
+            pose, position, approach = None, frame[:3, 3], frame[:3, 2]
         if (
             pose is not None
             and q_reference is None

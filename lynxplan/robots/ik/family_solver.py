@@ -126,7 +126,7 @@ def _al5_fill(
     batch = arm.ik_batch(
         target.poses, q_reference=ref, approach_only=target.kind == fk_.MODE_APPROACH
     )
-    ok = np.asarray(batch.status) == IkStatus.OK
+    ok: np.ndarray = np.asarray(np.asarray(batch.status) == IkStatus.OK)
     if not ok.any():
         return ok
     valid[ok] = True
