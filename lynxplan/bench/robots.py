@@ -9,11 +9,20 @@ Peers with conflicting requirements (placo needs pin 3.8) are not run in-process
 
 from __future__ import annotations
 
+import json
+import os
+import subprocess
+import tempfile
 import time
+from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from lynxplan.bench import Figure, median_seconds
+
+if TYPE_CHECKING:
+    from lynxplan.robots import Robot
 
 #: Round trips per robot in the full and the quick run.
 FULL_TRIPS, QUICK_TRIPS = 1_000_000, 10_000
@@ -38,6 +47,56 @@ def _round_trips(robot: object, count: int, seed: int) -> tuple[float, float, fl
         solved += int(np.count_nonzero(found & (errors <= 1e-9)))
         worst = max(worst, float(errors.max()))
     return solved / count, worst, seconds / count
+
+
+#: Peers run in their own virtual environments: PEERS_DIR/<peer>/bin/python (pink, ikpy).
+PEERS_DIR = os.environ.get("LYNXPLAN_PEERS_DIR", "/work/peers")
+
+
+def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
+    """Run each peer found in PEERS_DIR on the same poses (its own venv; JSON back)."""
+    figures = []
+    script = Path(__file__).with_name("peer_ik.py")
+    with tempfile.TemporaryDirectory() as folder:
+        poses_path = Path(folder) / "poses.npy"
+        np.save(poses_path, poses)
+        for peer in ("pink", "ikpy"):
+            python = Path(PEERS_DIR) / peer / "bin" / "python"
+            if not python.is_file():
+                continue
+            out = Path(folder) / f"{peer}.json"
+            args = [
+                str(python),
+                str(script),
+                peer,
+                str(robot.urdf_path),
+                robot.tool_frame,
+                str(poses_path),
+                str(out),
+            ]
+            done = subprocess.run(args, capture_output=True, text=True, timeout=3600, check=False)
+            if done.returncode != 0 or not out.is_file():
+                continue
+            result = json.loads(out.read_text())
+            name = f"{peer} {result['version']}"
+            figures += [
+                Figure(
+                    "robots",
+                    f"so101 {name} success ({result['count']}, zero start)",
+                    100 * result["success"],
+                    "%",
+                ),
+                Figure(
+                    "robots", f"so101 {name} median time per pose (wall)", result["median_us"], "us"
+                ),
+                Figure(
+                    "robots",
+                    f"so101 lynxplan speed-up over {peer}",
+                    result["median_us"] * 1e-6 / ours,
+                    "x",
+                ),
+            ]
+    return figures
 
 
 def run(quick: bool) -> list[Figure]:
@@ -110,6 +169,7 @@ def run(quick: bool) -> list[Figure]:
     clik = [solve_clik(robot.model, robot.data, robot.tool_frame_id, p, zero) for p in poses]
     clik_seconds = (time.thread_time() - begin) / count
     clik_success = float(np.mean([r.success for r in clik]))
+    figures += _peers(robot, poses, ours)
     figures += [
         Figure(
             "robots", f"so101 lynxplan IK success ({count} full poses)", 100 * ours_success, "%"
