@@ -37,6 +37,9 @@ BOUNDARY_SAMPLES = 32
 DUPLICATE_TOLERANCE = 1e-9
 #: Near-roots of the ideal model (|f| below this at a local extremum) are tried on the exact one.
 NEAR_ROOT = 5e-3
+#: A local extremum of the roll equation this close to zero is a double root (f is the sine of
+#: a roll mismatch or an axis component: 1e-10 means 1e-10 rad).
+TANGENT_TOLERANCE = 1e-10
 FAST_CHANGE = 0.25
 #: Roots where the tool point misses the yaw circle by more than this [m] are not solutions
 #: (more than the ~1e-7 m the exact model differs from the ideal one by).
@@ -425,6 +428,9 @@ def _roll_candidates(
             fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
             if fm == 0.0:
                 count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
+            elif (fm < 0.0) == (f0 < 0.0) and abs(fm) <= TANGENT_TOLERANCE:
+                # a double (tangent) root: f touches zero without crossing it
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
             elif prm[F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
                 # the exact model may have a close pair of roots here that the nearly
                 # identical ideal model lacks: tentative, kept only if Newton converges
@@ -451,6 +457,30 @@ def _roll_candidates(
                 count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
                 x = _refine_root(
                     prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[i + 1], f1
+                )
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+    # an extremum at either end of the range hides roots the scan above cannot see
+    for lo_i, hi_i, end in ((0, 1, 0), (m - 1, m, m)):
+        inner = 1 if end == 0 else m - 1
+        if (
+            count + 2 <= MAX_ROOTS
+            and m > 0
+            and fs[end] != 0.0
+            and (fs[end] < 0.0) == (fs[inner] < 0.0)
+            and abs(fs[end]) < abs(fs[inner])
+        ):
+            sign = 1.0 if fs[end] > 0 else -1.0
+            xm = _golden(prm, target, g, mode, side, phi_ref, sum_ref, xs[lo_i], xs[hi_i], sign)
+            fm = _roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
+            if abs(fm) <= TANGENT_TOLERANCE:
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
+            elif (fm < 0.0) != (fs[end] < 0.0):
+                x = _refine_root(
+                    prm, target, g, mode, side, phi_ref, sum_ref, xs[lo_i], fs[lo_i], xm, fm
+                )
+                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+                x = _refine_root(
+                    prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[hi_i], fs[hi_i]
                 )
                 count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
     best = 0
