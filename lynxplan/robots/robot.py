@@ -422,6 +422,11 @@ class Robot:
             oerr,
             miss,
         )
+        if not family.exact:
+            from lynxplan.robots.ik.family_solver import rescue_near_axis
+
+            one = Target(poses, 0, _ZERO1, _NAN1)
+            rescue_near_axis(self, one, q, valid, within, perr, oerr)
         distance = float(np.where(valid, perr, np.inf).min())
         reachable = distance <= REACH_TOLERANCE
         if reachable:

@@ -66,6 +66,7 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         _kernel(robot, sub, ref, *parts)
         for whole, part in zip((q, valid, within, perr, oerr), parts, strict=True):
             whole[rest] = part
+    rescue_near_axis(robot, target, q, valid, within, perr, oerr)
     distance = np.where(valid, perr, np.inf).min(axis=1)
     reachable = distance <= REACH_TOLERANCE
     # a reachable target's solutions are the branches that reach it; the others are dropped
@@ -73,6 +74,76 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)
     return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
+
+
+#: Targets this much closer to the yaw axis than the wrist's lateral offset plus the tool's
+#: off-axis distance are "near the axis" [m]: there the yaw is so sensitive that a model only
+#: close to the family (SO-101) can hide a root of the exact model from the ideal one.
+NEAR_AXIS_MARGIN = 0.01
+
+
+def rescue_near_axis(
+    robot: Robot,
+    target: Target,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> None:
+    """Near-family models, full poses near the yaw axis with no exact branch: Levenberg-Marquardt
+    on the exact chain from each closed-form branch; converged, new answers are added.
+
+    The numerical solver accepts only answers that reach the pose to 1e-10 m and 1e-9 rad.
+    """
+    from lynxplan.robots.ik.numerical import numerical_ik_kernel
+    from lynxplan.robots.robot import REACH_TOLERANCE
+
+    family = robot.family
+    assert family is not None
+    if family.exact or target.kind != fk_.MODE_POSE or family.tool_on_roll_axis:
+        return
+    k = np.array(family.yaw_axis)
+    d = target.poses[:, :3, 3] - family.packed[0:3]
+    rho = np.linalg.norm(d - np.outer(d @ k, k), axis=1)
+    near = rho < abs(family.lateral_offset) + family.tool_offset[1] + NEAR_AXIS_MARGIN
+    reached = np.where(valid, perr, np.inf).min(axis=1) <= REACH_TOLERANCE
+    exact = np.where(valid, oerr, np.inf).min(axis=1) <= 1e-9
+    lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
+    for row in np.flatnonzero(near & reached & ~exact):
+        seeds = np.ascontiguousarray(q[row][valid[row]])
+        n = seeds.shape[0]
+        if n == 0:
+            continue
+        found = np.empty((n, 5))
+        ok = np.empty(n, dtype=np.bool_)
+        p_err, o_err = np.empty(n), np.empty(n)
+        iterations = np.empty(n, dtype=np.int64)
+        numerical_ik_kernel(
+            robot.chain.placements,
+            robot.chain.axes,
+            np.repeat(target.poses[row : row + 1], n, 0),
+            False,
+            lower,
+            upper,
+            seeds,
+            np.empty((0, 5)),
+            found,
+            ok,
+            p_err,
+            o_err,
+            iterations,
+        )
+        for i in np.flatnonzero(ok):
+            taken = q[row][valid[row]]
+            if taken.size and np.abs(taken - found[i]).max(axis=1).min() < 1e-9:
+                continue
+            free = np.flatnonzero(~valid[row])
+            if free.size == 0:
+                break
+            slot = free[0]
+            q[row, slot], valid[row, slot], within[row, slot] = found[i], True, True
+            perr[row, slot], oerr[row, slot] = p_err[i], o_err[i]
 
 
 def _kernel(
