@@ -80,6 +80,9 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
 #: off-axis distance are "near the axis" [m]: there the yaw is so sensitive that a model only
 #: close to the family (SO-101) can hide a root of the exact model from the ideal one.
 NEAR_AXIS_MARGIN = 0.01
+#: Besides the closed-form branches, the rescue starts from this many fixed random configurations.
+RESCUE_STARTS = 16
+RESCUE_SEED = 5
 
 
 def rescue_near_axis(
@@ -111,10 +114,9 @@ def rescue_near_axis(
     exact = np.where(valid, oerr, np.inf).min(axis=1) <= 1e-9
     lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
     for row in np.flatnonzero(near & reached & ~exact):
-        seeds = np.ascontiguousarray(q[row][valid[row]])
+        extra = np.random.default_rng(RESCUE_SEED).uniform(lower, upper, size=(RESCUE_STARTS, 5))
+        seeds = np.ascontiguousarray(np.vstack((q[row][valid[row]], extra)))
         n = seeds.shape[0]
-        if n == 0:
-            continue
         found = np.empty((n, 5))
         ok = np.empty(n, dtype=np.bool_)
         p_err, o_err = np.empty(n), np.empty(n)
