@@ -37,6 +37,7 @@ def _dense_search(robot: Robot, pose: np.ndarray, approach_only: bool) -> np.nda
         perr,
         oerr,
         iterations,
+        np.array([0.0, 0.0, 1.0]),
     )
     return q[ok]
 

@@ -83,6 +83,8 @@ NEAR_AXIS_MARGIN = 0.01
 #: Besides the closed-form branches, the rescue starts from this many fixed random configurations.
 RESCUE_STARTS = 16
 RESCUE_SEED = 5
+#: Approach targets: the rescue starts from each branch with its roll moved by these [rad].
+ROLL_NUDGES = (-0.8, -0.4, -0.2, -0.1, 0.1, 0.2, 0.4, 0.8)
 
 
 def rescue_near_axis(
@@ -94,28 +96,49 @@ def rescue_near_axis(
     perr: np.ndarray,
     oerr: np.ndarray,
 ) -> None:
-    """Near-family models, full poses near the yaw axis with no exact branch: Levenberg-Marquardt
-    on the exact chain from each closed-form branch; converged, new answers are added.
+    """Near-family models (off-axis tool): Levenberg-Marquardt on the exact chain adds the
+    branches the ideal model misses. Full poses near the yaw axis with no exact branch: from
+    each branch and fixed random starts. Approach targets with the roll free and no exact
+    branch: also from each branch with its roll nudged (near-double roots split differently).
 
     The numerical solver accepts only answers that reach the pose to 1e-10 m and 1e-9 rad.
     """
     from lynxplan.robots.ik.numerical import numerical_ik_kernel
-    from lynxplan.robots.robot import REACH_TOLERANCE
 
     family = robot.family
     assert family is not None
-    if family.exact or target.kind != fk_.MODE_POSE or family.tool_on_roll_axis:
+    if family.exact or family.tool_on_roll_axis or target.kind == fk_.MODE_PITCH:
         return
-    k = np.array(family.yaw_axis)
-    d = target.poses[:, :3, 3] - family.packed[0:3]
-    rho = np.linalg.norm(d - np.outer(d @ k, k), axis=1)
-    near = rho < abs(family.lateral_offset) + family.tool_offset[1] + NEAR_AXIS_MARGIN
-    reached = np.where(valid, perr, np.inf).min(axis=1) <= REACH_TOLERANCE
-    exact = np.where(valid, oerr, np.inf).min(axis=1) <= 1e-9
+    exact_count = np.count_nonzero(valid & (oerr <= 1e-9), axis=1)
     lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
-    for row in np.flatnonzero(near & reached & ~exact):
-        extra = np.random.default_rng(RESCUE_SEED).uniform(lower, upper, size=(RESCUE_STARTS, 5))
-        seeds = np.ascontiguousarray(np.vstack((q[row][valid[row]], extra)))
+    approach_only = target.kind == fk_.MODE_APPROACH
+    if approach_only:
+        # near-double roots of the approach equation split differently on the exact model:
+        # with no exact branch found, look next to the branches along the roll
+        # (also when no branch reaches the position: the polish failed on every one)
+        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
+        rows = np.flatnonzero(near_miss & np.isnan(target.roll) & (exact_count == 0))
+    else:
+        k = np.array(family.yaw_axis)
+        d = target.poses[:, :3, 3] - family.packed[0:3]
+        rho = np.linalg.norm(d - np.outer(d @ k, k), axis=1)
+        near = rho < abs(family.lateral_offset) + family.tool_offset[1] + NEAR_AXIS_MARGIN
+        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
+        rows = np.flatnonzero(near & near_miss & (exact_count == 0))
+    axis = np.array(family.approach_in_tool)
+    for row in rows:
+        branches = q[row][valid[row]]
+        if approach_only:
+            nudged = [branches + np.array([0, 0, 0, 0, s]) for s in ROLL_NUDGES]
+            extra = np.random.default_rng(RESCUE_SEED).uniform(
+                lower, upper, size=(RESCUE_STARTS, 5)
+            )
+            seeds = np.ascontiguousarray(np.vstack((*nudged, extra)))
+        else:
+            extra = np.random.default_rng(RESCUE_SEED).uniform(
+                lower, upper, size=(RESCUE_STARTS, 5)
+            )
+            seeds = np.ascontiguousarray(np.vstack((branches, extra)))
         n = seeds.shape[0]
         found = np.empty((n, 5))
         ok = np.empty(n, dtype=np.bool_)
@@ -125,7 +148,7 @@ def rescue_near_axis(
             robot.chain.placements,
             robot.chain.axes,
             np.repeat(target.poses[row : row + 1], n, 0),
-            False,
+            approach_only,
             lower,
             upper,
             seeds,
@@ -135,6 +158,7 @@ def rescue_near_axis(
             p_err,
             o_err,
             iterations,
+            axis,
         )
         for i in np.flatnonzero(ok):
             taken = q[row][valid[row]]

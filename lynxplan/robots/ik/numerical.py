@@ -25,14 +25,16 @@ DEFAULT_STARTS = 128
 
 
 @numba.njit(cache=True, nogil=True)
-def _error(pose: np.ndarray, target: np.ndarray, approach_only: bool, e: np.ndarray) -> None:
+def _error(
+    pose: np.ndarray, target: np.ndarray, approach_only: bool, e: np.ndarray, u: np.ndarray
+) -> None:
     """Position error then orientation error (Siciliano: 0.5 sum n_i x n_t,i; approach: a_t - a)."""
     for i in range(3):
         e[i] = target[i, 3] - pose[i, 3]
         e[3 + i] = 0.0
     if approach_only:  # a_t - a, whose Jacobian is w x a (see _approach_rows)
         for i in range(3):
-            e[3 + i] = target[i, 2] - pose[i, 2]
+            e[3 + i] = target[i, 2] - (pose[i, 0] * u[0] + pose[i, 1] * u[1] + pose[i, 2] * u[2])
         return
     scale = 0.5
     for c in range(3):
@@ -44,9 +46,11 @@ def _error(pose: np.ndarray, target: np.ndarray, approach_only: bool, e: np.ndar
 
 
 @numba.njit(cache=True, nogil=True)
-def _approach_rows(pose: np.ndarray, jac: np.ndarray) -> None:
-    """Angular rows w_i -> w_i x a: the rate of the approach axis a (tool z) per joint."""
-    a0, a1, a2 = pose[0, 2], pose[1, 2], pose[2, 2]
+def _approach_rows(pose: np.ndarray, jac: np.ndarray, u: np.ndarray) -> None:
+    """Angular rows w_i -> w_i x a: the rate of the approach axis a = R u per joint."""
+    a0 = pose[0, 0] * u[0] + pose[0, 1] * u[1] + pose[0, 2] * u[2]
+    a1 = pose[1, 0] * u[0] + pose[1, 1] * u[1] + pose[1, 2] * u[2]
+    a2 = pose[2, 0] * u[0] + pose[2, 1] * u[1] + pose[2, 2] * u[2]
     for i in range(jac.shape[1]):
         w0, w1, w2 = jac[3, i], jac[4, i], jac[5, i]
         jac[3, i] = w1 * a2 - w2 * a1
@@ -55,12 +59,15 @@ def _approach_rows(pose: np.ndarray, jac: np.ndarray) -> None:
 
 
 @numba.njit(cache=True, nogil=True)
-def _angle(pose: np.ndarray, target: np.ndarray, approach_only: bool) -> float:
+def _angle(pose: np.ndarray, target: np.ndarray, approach_only: bool, u: np.ndarray) -> float:
     if approach_only:
-        c0 = pose[1, 2] * target[2, 2] - pose[2, 2] * target[1, 2]
-        c1 = pose[2, 2] * target[0, 2] - pose[0, 2] * target[2, 2]
-        c2 = pose[0, 2] * target[1, 2] - pose[1, 2] * target[0, 2]
-        d = pose[0, 2] * target[0, 2] + pose[1, 2] * target[1, 2] + pose[2, 2] * target[2, 2]
+        a0 = pose[0, 0] * u[0] + pose[0, 1] * u[1] + pose[0, 2] * u[2]
+        a1 = pose[1, 0] * u[0] + pose[1, 1] * u[1] + pose[1, 2] * u[2]
+        a2 = pose[2, 0] * u[0] + pose[2, 1] * u[1] + pose[2, 2] * u[2]
+        c0 = a1 * target[2, 2] - a2 * target[1, 2]
+        c1 = a2 * target[0, 2] - a0 * target[2, 2]
+        c2 = a0 * target[1, 2] - a1 * target[0, 2]
+        d = a0 * target[0, 2] + a1 * target[1, 2] + a2 * target[2, 2]
         return math.atan2(math.sqrt(c0 * c0 + c1 * c1 + c2 * c2), d)
     tr = 0.0
     m = np.zeros((3, 3))
@@ -88,11 +95,13 @@ def numerical_ik_kernel(
     position_error: np.ndarray,
     orientation_error: np.ndarray,
     iterations: np.ndarray,
+    approach_axis: np.ndarray,
 ) -> None:
     """Levenberg-Marquardt IK of N targets (see module docstring).
 
     Args:
-        targets: (N, 4, 4) poses [m]; approach_only: only column 2 of the rotation counts.
+        targets: (N, 4, 4) poses [m]; approach_only: only column 2 of the rotation counts: the
+            tool axis ``approach_axis`` (tool-frame unit vector, (3,)) must point along it.
         lower, upper: (n,) joint limits [rad].
         reference: (N, n) or (1, n) first start [rad]; starts: (S, n) further starts [rad].
         q_out: (N, n) best configuration found; success: (N,) verified within tolerance.
@@ -122,8 +131,8 @@ def numerical_ik_kernel(
             lam = 1e-3
             chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
             if approach_only:
-                _approach_rows(pose, jac)
-            _error(pose, target, approach_only, e)
+                _approach_rows(pose, jac, approach_axis)
+            _error(pose, target, approach_only, e, approach_axis)
             cost = 0.0
             for i in range(6):
                 cost += e[i] * e[i]
@@ -146,8 +155,8 @@ def numerical_ik_kernel(
                     q_new[j] = min(max(q[j] + step[j], lower[j]), upper[j])
                 chain_fk_jacobian(placements, axes, q_new, pose, jac, work, origins)
                 if approach_only:
-                    _approach_rows(pose, jac)
-                _error(pose, target, approach_only, e_new)
+                    _approach_rows(pose, jac, approach_axis)
+                _error(pose, target, approach_only, e_new, approach_axis)
                 new_cost = 0.0
                 for i in range(6):
                     new_cost += e_new[i] * e_new[i]
@@ -160,7 +169,7 @@ def numerical_ik_kernel(
                     lam *= 4.0
                     chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
                     if approach_only:
-                        _approach_rows(pose, jac)
+                        _approach_rows(pose, jac, approach_axis)
                     if lam > 1e8:
                         break
             chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
@@ -169,7 +178,7 @@ def numerical_ik_kernel(
                 + (pose[1, 3] - target[1, 3]) ** 2
                 + (pose[2, 3] - target[2, 3]) ** 2
             )
-            oerr = _angle(pose, target, approach_only)
+            oerr = _angle(pose, target, approach_only, approach_axis)
             score = perr + 0.1 * oerr
             if score < best_cost:
                 best_cost = score

@@ -48,6 +48,7 @@ def solve_numerical(
         perr,
         oerr,
         iterations,
+        np.array([0.0, 0.0, 1.0]),
     )
     within = success.copy()
     arrays = (
