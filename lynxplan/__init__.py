@@ -6,11 +6,16 @@
 
 from __future__ import annotations
 
+from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING, Any
 
 from lynxplan.exceptions import LynxplanError
 
-__version__ = "0.1.0"
+try:
+    #: The installed distribution's version (pyproject.toml is the one place it is written).
+    __version__ = version("lynxplan")
+except PackageNotFoundError:  # a source tree on sys.path without an installed distribution
+    __version__ = "0+unknown"
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm

@@ -60,7 +60,7 @@ def sincos(x: float) -> tuple[float, float]:
         sign_s, sign_c = -sign_s, -sign_c
     if j > 1:
         sign_c = -sign_c
-    if j == 1 or j == 2:
+    if j == 1 or j == 2:  # noqa: PLR1714 (numba kernel: no set literal)
         s, c = c, s
     return sign_s * s, sign_c * c
 

@@ -81,7 +81,7 @@ def _frame_from_normal(normal: np.ndarray) -> np.ndarray:
 
 
 def _hex(rgba: np.ndarray) -> int:
-    r, g, b = (int(round(float(c) * 255)) for c in rgba[:3])
+    r, g, b = (round(float(c) * 255) for c in rgba[:3])
     return (r << 16) | (g << 8) | b
 
 

@@ -10,7 +10,7 @@ from lynxplan.units import INCH
 
 
 def _limits(*degrees: tuple[float, float]) -> np.ndarray:
-    array = np.radians(np.array(degrees, dtype=float))
+    array: np.ndarray = np.radians(np.array(degrees, dtype=float))
     array.setflags(write=False)
     return array
 

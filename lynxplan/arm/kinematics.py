@@ -11,10 +11,25 @@ import numba
 import numpy as np
 
 from lynxplan._fastmath import sincos
+from lynxplan.arm.closed_form import tool_pose_from_sines
+from lynxplan.arm.configuration import as_configurations
 from lynxplan.arm.geometry import ArmGeometry
-from lynxplan.exceptions import NonFiniteInputError, ShapeError
+from lynxplan.exceptions import ShapeError
+
+__all__ = [
+    "as_configurations",
+    "fk_kernel",
+    "forward_kinematics",
+    "jacobian_kernel",
+    "tool_jacobian",
+]
 
 _DEFAULT_GEOMETRY = ArmGeometry()
+
+
+_tool_pose = numba.njit(cache=True, nogil=True, inline="always", fastmath={"contract"})(
+    tool_pose_from_sines
+)
 
 
 @numba.njit(cache=True, nogil=True, fastmath={"contract"})  # FMA: same results to an ulp
@@ -26,29 +41,7 @@ def fk_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -
         s3, c3 = sincos(q[k, 2])
         s4, c4 = sincos(q[k, 3])
         s5, c5 = sincos(q[k, 4])
-        # Angle sums by the addition theorems: 5 sine/cosine pairs instead of 6.
-        s23, c23 = s2 * c3 + c2 * s3, c2 * c3 - s2 * s3
-        s234, c234 = s23 * c4 + c23 * s4, c23 * c4 - s23 * s4
-        r = d5 * s234 + a3 * c23 + a2 * c2
-        # Frame-4 axes x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0); n = c5 x4 + s5 y4,
-        # o = -s5 x4 + c5 y4, a = z4 = (c1 s234, s1 s234, -c234)  (SPEC Part 1, closed form).
-        t = out[k]
-        t[0, 0] = c5 * c1 * c234 + s5 * s1
-        t[1, 0] = c5 * s1 * c234 - s5 * c1
-        t[2, 0] = c5 * s234
-        t[0, 1] = -s5 * c1 * c234 + c5 * s1
-        t[1, 1] = -s5 * s1 * c234 - c5 * c1
-        t[2, 1] = -s5 * s234
-        t[0, 2] = c1 * s234
-        t[1, 2] = s1 * s234
-        t[2, 2] = -c234
-        t[0, 3] = c1 * r
-        t[1, 3] = s1 * r
-        t[2, 3] = a3 * s23 + a2 * s2 - d5 * c234
-        t[3, 0] = 0.0
-        t[3, 1] = 0.0
-        t[3, 2] = 0.0
-        t[3, 3] = 1.0
+        _tool_pose((s1, s2, s3, s4, s5), (c1, c2, c3, c4, c5), a2, a3, d5, out[k])
 
 
 @numba.njit(cache=True, nogil=True)
@@ -83,18 +76,6 @@ def jacobian_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndar
         for col in range(1, 4):
             j[3, col], j[4, col], j[5, col] = s1, -c1, 0.0
         j[3, 4], j[4, 4], j[5, 4] = c1 * s234, s1 * s234, -c234
-
-
-def as_configurations(
-    q: np.ndarray | list[float] | tuple[float, ...], name: str = "q"
-) -> np.ndarray:
-    """Validate joint angles: shape (5,) or (N, 5), finite. Returns a float (N, 5) array."""
-    array = np.asarray(q, dtype=float)
-    if array.ndim not in (1, 2) or array.shape[-1] != 5:
-        raise ShapeError(name, "(5,) or (N, 5)", array.shape)
-    if not np.isfinite(array).all():
-        raise NonFiniteInputError(name)
-    return np.ascontiguousarray(array.reshape(-1, 5))
 
 
 def forward_kinematics(

@@ -12,13 +12,12 @@ from dataclasses import dataclass
 from functools import cached_property
 from importlib import resources
 from pathlib import Path
-from typing import Any, Literal, NamedTuple
+from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 import numpy as np
 
-from lynxplan.arm import ik as _ik
+from lynxplan.arm.configuration import as_configurations
 from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
-from lynxplan.arm.kinematics import as_configurations, forward_kinematics, tool_jacobian
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
     RIGIDITY_REPAIR_TOLERANCE,
@@ -33,6 +32,24 @@ from lynxplan.exceptions import (
     ShapeError,
     UnreachablePoseError,
 )
+
+if TYPE_CHECKING:
+    from types import ModuleType
+
+    from lynxplan.arm.ik import IkBatch
+
+_IK_MODULE: ModuleType | None = None
+
+
+def _ik() -> ModuleType:
+    """:mod:`lynxplan.arm.ik`, imported on first use (numba: FK-only commands start faster)."""
+    global _IK_MODULE
+    if _IK_MODULE is None:
+        from lynxplan.arm import ik
+
+        _IK_MODULE = ik
+    return _IK_MODULE
+
 
 DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
 #: Tolerance on the URDF's DH structure (rotations, zero offsets), unitless / [m].
@@ -152,10 +169,14 @@ class Arm:
     # -- kinematics -------------------------------------------------------------------------------
     def fk(self, q: np.ndarray) -> np.ndarray:
         """Tool pose (closed form). q: shape (5,) or (N, 5) in [rad] -> (4, 4) or (N, 4, 4), [m]."""
+        from lynxplan.arm.kinematics import forward_kinematics
+
         return forward_kinematics(q, self.geometry)
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
         """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5)."""
+        from lynxplan.arm.kinematics import tool_jacobian
+
         return tool_jacobian(q, self.geometry)
 
     def frame_placement(self, q: np.ndarray, frame: str = TOOL_FRAME) -> np.ndarray:
@@ -199,9 +220,9 @@ class Arm:
         q_reference: np.ndarray | None = None,
         approach_only: bool = False,
         limit_tolerance: float = LIMIT_SNAP_TOLERANCE,
-    ) -> _ik.IkBatch:
+    ) -> IkBatch:
         """All-branch IK of many poses; see :func:`lynxplan.arm.ik.solve_ik_batch`."""
-        return _ik.solve_ik_batch(
+        return _ik().solve_ik_batch(  # type: ignore[no-any-return]
             T,
             geometry=self.geometry,
             limits=self.limits,
@@ -258,9 +279,10 @@ class Arm:
         if limit_tolerance != LIMIT_SNAP_TOLERANCE:
             params = params.copy()
             params[3] = limit_tolerance
-        _ik.ik_single_kernel(pose, reference, params, flags, rows, scalars)
+        ik = _ik()
+        ik.ik_single_kernel(pose, reference, params, flags, rows, scalars)
         residual, status, miss, deviation, selected = scalars.tolist()
-        if int(status) == _ik.IkStatus.NOT_RIGID and np.abs(pose[3] - _BOTTOM_ROW).max() > 1e-9:
+        if int(status) == ik.IkStatus.NOT_RIGID and np.abs(pose[3] - _BOTTOM_ROW).max() > 1e-9:
             raise NotRigidTransformError(
                 float(np.abs(pose[3] - _BOTTOM_ROW).max()), 0.0, "pose (last row must be 0 0 0 1)"
             )
@@ -270,7 +292,7 @@ class Arm:
         q = rows[:, :5]
         q.setflags(write=False)
         values = rows[:, 5:].tolist()
-        names = _ik.BRANCH_NAMES
+        names = ik.BRANCH_NAMES
         solutions = (
             IkSolution(q[0], names[0], values[0][0] > 0.5, values[0][1], values[0][2]),
             IkSolution(q[1], names[1], values[1][0] > 0.5, values[1][1], values[1][2]),
@@ -281,11 +303,12 @@ class Arm:
 
 
 def _raise_for_status(status: int, miss: float, deviation: float) -> None:
-    if status == _ik.IkStatus.NON_FINITE:
+    ik_status = _ik().IkStatus
+    if status == ik_status.NON_FINITE:
         raise NonFiniteInputError("T")
-    if status == _ik.IkStatus.NOT_RIGID:
+    if status == ik_status.NOT_RIGID:
         raise NotRigidTransformError(deviation, RIGIDITY_REPAIR_TOLERANCE)
-    if status == _ik.IkStatus.OUT_OF_REACH:
+    if status == ik_status.OUT_OF_REACH:
         raise UnreachablePoseError(miss)
 
 

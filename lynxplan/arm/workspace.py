@@ -94,7 +94,7 @@ def planar_membership_kernel(
     """
     psi_lo = lower[1] + lower[2] + lower[3]
     psi_hi = upper[1] + upper[2] + upper[3]
-    n_steps = int(math.ceil((psi_hi - psi_lo) / step)) + 1
+    n_steps = math.ceil((psi_hi - psi_lo) / step) + 1
     for k in range(points.shape[0]):
         r, z = points[k, 0], points[k, 1]
         out[k] = False
@@ -126,8 +126,10 @@ def report_grid(limits: JointLimits) -> np.ndarray:
         Configurations, shape (N, 5), in [rad] (N = 164,944 for the AL5 limits).
     """
     axes = [np.arange(limits.lower[0], limits.upper[0] + 1e-12, REPORT_STEP_Q1)]
-    for joint in (1, 2, 3):
-        axes.append(np.arange(limits.lower[joint], limits.upper[joint] + 1e-12, REPORT_STEP_ARM))
+    axes += [
+        np.arange(limits.lower[joint], limits.upper[joint] + 1e-12, REPORT_STEP_ARM)
+        for joint in (1, 2, 3)
+    ]
     grid = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 4)
     return np.column_stack((grid, np.zeros(grid.shape[0])))
 
@@ -174,10 +176,10 @@ def estimate_workspace(
             raise InputError(f"workspace: {name} must be a positive length in m. Got: {value}")
     rng = np.random.default_rng(seed)
     reach = geometry.max_reach
-    n_cells = int(math.ceil(2 * reach / cell)) + 2
+    n_cells = math.ceil(2 * reach / cell) + 2
     planar_counts = np.zeros((n_cells, n_cells), dtype=bool)  # (z, signed r) over [-reach, reach]
     voxels: set[int] = set()
-    n_vox = int(math.ceil(2 * reach / voxel_size)) + 2
+    n_vox = math.ceil(2 * reach / voxel_size) + 2
     kept: list[np.ndarray] = []
     max_reach, z_min, z_max = 0.0, math.inf, -math.inf
     done, chunk = 0, 500_000
@@ -223,7 +225,7 @@ def _shifted_any(mask: np.ndarray, radius: int) -> np.ndarray:
     for di in range(-radius, radius + 1):
         for dj in range(-radius, radius + 1):
             out |= np.roll(np.roll(mask, di, axis=0), dj, axis=1)
-    return out
+    return np.asarray(out)
 
 
 def _refine_boundary(
@@ -244,7 +246,7 @@ def _refine_boundary(
     planar_membership_kernel(
         points, geometry.a2, geometry.a3, geometry.d5, limits.lower, limits.upper, step, member
     )
-    result = interior.copy()
+    result: np.ndarray = interior.copy()
     result[iz[member], ir[member]] = True
     return result
 
@@ -252,7 +254,7 @@ def _refine_boundary(
 def _fold_envelope(planar: np.ndarray, cell: float, reach: float) -> Envelope:
     """Signed-r occupancy -> occupancy of the half-plane r >= 0 (both signs folded)."""
     n = planar.shape[1]
-    centre = int(round(reach / cell))  # index of the cell starting at r = 0
+    centre = round(reach / cell)  # index of the cell starting at r = 0
     positive = planar[:, centre:]
     negative = planar[:, :centre][:, ::-1]
     width = max(positive.shape[1], negative.shape[1])

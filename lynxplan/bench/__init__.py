@@ -19,6 +19,7 @@ SECTIONS: dict[str, str] = {
     "trajectory": "lynxplan.bench.trajectory",
     "collision": "lynxplan.bench.collision",
     "task": "lynxplan.bench.task",
+    "cold": "lynxplan.bench.cold",
     "robots": "lynxplan.bench.robots",
 }
 

@@ -32,7 +32,7 @@ def _loop_sample(plan: object) -> np.ndarray:
     upper = plan.limits.position[:, 1].copy()  # type: ignore[attr-defined]
     segments = plan.segments  # type: ignore[attr-defined]
     starts = np.concatenate([[0.0], np.cumsum([seg.duration for seg in segments])])
-    count = int(math.floor(starts[-1] * RATE + 1e-9)) + 1
+    count = math.floor(starts[-1] * RATE + 1e-9) + 1
     tool = np.empty((1, 4, 4))
     target = np.eye(4)
     out = np.empty((count, 5))

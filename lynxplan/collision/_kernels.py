@@ -108,5 +108,4 @@ def obstacle_bounds_kernel(
                     p0, p1, p2 = max(e0, 0.0), max(e1, 0.0), max(e2, 0.0)
                     signed = math.sqrt(p0 * p0 + p1 * p1 + p2 * p2) + min(max(e0, e1, e2), 0.0)
                 bound = signed - sphere_radius[g]
-                if bound < out[n, g, o]:
-                    out[n, g, o] = bound
+                out[n, g, o] = min(out[n, g, o], bound)

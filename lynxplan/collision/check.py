@@ -354,4 +354,4 @@ def _interpolation_margins(world: CollisionWorld, bound: Any, times: np.ndarray)
         )
     # Linear interpolation error of a C2 function: |q - lerp| <= max|q''| dt^2 / 8 per joint.
     joint_error = np.diff(times)[:, None] ** 2 / 8.0 * acceleration  # (N - 1, nq)
-    return (joint_error @ world._reach.T).max(axis=1)
+    return np.asarray((joint_error @ world._reach.T).max(axis=1))

@@ -29,55 +29,28 @@ answer cannot matter (branch and bound), never to report a clearance.
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from lynxplan.collision import _kernels
 from lynxplan.collision.obstacles import (
-    BoxObstacle,
-    CylinderObstacle,
     Obstacle,
-    SphereObstacle,
+)
+from lynxplan.collision.primitives import (
+    LinkPrimitive,
+    fcl_shape,
+    joint_structure,
+    link_primitive,
+    obstacle_arrays,
+    signed_distance,
 )
 from lynxplan.constants import COAL_GJK_TOLERANCE
 from lynxplan.exceptions import CollisionModelError, NonFiniteInputError, ShapeError
 
-_AXES = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}
-
-
-@dataclass(frozen=True)
-class LinkPrimitive:
-    """One collision primitive of the arm.
-
-    Attributes:
-        geometry: Name of the geometry object, e.g. ``"gripper_1"``.
-        link: Name of the URDF link carrying it, e.g. ``"gripper"``.
-        joint: Index of the Pinocchio joint that moves it (0: fixed to the base).
-        placement: Pose in the joint frame, shape (4, 4), in [m].
-        kind: ``"box"`` or ``"cylinder"``.
-        half_extents: Box half sizes (3,), or (radius, half length, 0) of a cylinder, in [m].
-        sphere_centres: Covering sphere centres in the primitive frame, shape (K, 3), in [m].
-        sphere_radius: Radius of every covering sphere, in [m].
-        reach: Upper bound of the distance of any point of the primitive from the axis of each
-            joint (shape (nq,), in [m]; 0 for joints that do not move it).
-    """
-
-    geometry: str
-    link: str
-    joint: int
-    placement: np.ndarray
-    kind: str
-    half_extents: np.ndarray
-    sphere_centres: np.ndarray
-    sphere_radius: float
-    reach: np.ndarray
-
 
 class CollisionWorld:
-    """The arm's collision primitives and a set of obstacles, as python-fcl objects built once.
+    """The arm's collision primitives and a set of obstacles, as collision objects built once.
 
     Args:
         arm: The arm (``lynxplan.arm.Arm``): its Pinocchio model and collision GeometryModel.
@@ -102,7 +75,6 @@ class CollisionWorld:
         engine: str = "coal",
     ) -> None:
         import coal
-        import fcl
 
         if engine not in ("coal", "fcl"):
             raise CollisionModelError("engine", f"engine must be 'coal' or 'fcl'. Got: {engine!r}")
@@ -113,18 +85,11 @@ class CollisionWorld:
         names = [o.name for o in self.obstacles]
         if len(set(names)) != len(names):
             raise CollisionModelError("obstacles", f"obstacle names must be unique. Got: {names}")
-        self._joint_axes, self._joint_placements = _joint_structure(self.model)
+        self._joint_axes, self._joint_placements = joint_structure(self.model)
         self.links: tuple[LinkPrimitive, ...] = tuple(
-            _primitive(self.model, g, self._joint_placements)
+            link_primitive(self.model, g, self._joint_placements)
             for g in arm.collision_model.geometryObjects
         )
-        self._link_objects = [
-            fcl.CollisionObject(_fcl_shape(p), fcl.Transform()) for p in self.links
-        ]
-        self._obstacle_objects = [
-            fcl.CollisionObject(o.fcl_geometry(), fcl.Transform(np.asarray(o.rotation), o.centre))
-            for o in self.obstacles
-        ]
         pairs = [(g, o, False) for o in range(len(self.obstacles)) for g in range(len(self.links))]
         if self_collision:
             parents = list(self.model.parents)
@@ -138,7 +103,8 @@ class CollisionWorld:
         self.pair_is_self = np.array([p[2] for p in pairs], dtype=bool)
         for array in (self.pair_link, self.pair_other, self.pair_is_self):
             array.setflags(write=False)
-        self._request = fcl.DistanceRequest(enable_signed_distance=True)
+        if engine == "fcl":
+            self._build_fcl()
         shapes = [g.geometry for g in arm.collision_model.geometryObjects]
         self._coal_link_poses = [coal.Transform3s() for _ in self.links]
         self._coal_obstacle_poses = [
@@ -175,7 +141,7 @@ class CollisionWorld:
             self._primitive_joints.astype(np.int64),
             self._primitive_placements,
         )
-        self._kernel_obstacles = _obstacle_arrays(self.obstacles)
+        self._kernel_obstacles = obstacle_arrays(self.obstacles)
 
     # -- names --------------------------------------------------------------------------------
     @property
@@ -239,7 +205,7 @@ class CollisionWorld:
             )
             gaps = np.linalg.norm(centres[:, sa, None, :] - centres[:, None, sb, :], axis=-1)
             bounds[:, p] = gaps.min(axis=(1, 2)) - self._sphere_radius[a] - self._sphere_radius[b]
-        return bounds
+        return np.asarray(bounds)
 
     def distance(self, poses: np.ndarray, pair: int) -> float:
         """Signed distance of one pair, in [m]; negative: minus the penetration depth.
@@ -265,6 +231,23 @@ class CollisionWorld:
         # A DistanceResult keeps the minimum over calls: a fresh one per query.
         result = self._coal_result_type()
         return float(self._coal_pairs[pair](first, second, self._coal_request, result))
+
+    def _build_fcl(self) -> None:
+        """python-fcl objects of the links and obstacles (the cross-check engine only)."""
+        try:
+            import fcl
+        except ImportError as exc:
+            raise CollisionModelError(
+                "engine", "engine 'fcl' needs python-fcl (pip install 'lynxplan[test]')"
+            ) from exc
+        self._link_objects = [
+            fcl.CollisionObject(fcl_shape(p), fcl.Transform()) for p in self.links
+        ]
+        self._obstacle_objects = [
+            fcl.CollisionObject(o.fcl_geometry(), fcl.Transform(np.asarray(o.rotation), o.centre))
+            for o in self.obstacles
+        ]
+        self._request = fcl.DistanceRequest(enable_signed_distance=True)
 
     def _fcl_distance(self, poses: np.ndarray, pair: int) -> float:
         import fcl
@@ -306,7 +289,7 @@ class CollisionWorld:
         bounds = per_link[:, self.pair_link]
         if self.pair_is_self.any():
             bounds[:, self.pair_is_self] += per_link[:, self.pair_other[self.pair_is_self]]
-        return bounds
+        return np.asarray(bounds)
 
 
 def _configurations(q: Any, nq: int) -> np.ndarray:
@@ -320,105 +303,4 @@ def _configurations(q: Any, nq: int) -> np.ndarray:
     return config
 
 
-def _joint_structure(model: Any) -> tuple[list[tuple[int, int]], list[np.ndarray]]:
-    axes: list[tuple[int, int]] = [(-1, -1)]
-    for j in range(1, model.njoints):
-        joint = model.joints[j]
-        if joint.shortname() not in _AXES:
-            raise CollisionModelError(
-                model.names[j], f"joint type {joint.shortname()} is not supported (revolute x/y/z)"
-            )
-        axes.append((_AXES[joint.shortname()], joint.idx_q))
-    placements = [np.array(model.jointPlacements[j].homogeneous) for j in range(model.njoints)]
-    return axes, placements
-
-
-def _primitive(
-    model: Any, geometry_object: Any, joint_placements: list[np.ndarray]
-) -> LinkPrimitive:
-    shape = geometry_object.geometry
-    kind = type(shape).__name__
-    name = geometry_object.name
-    if kind == "Box":
-        half = np.array(shape.halfSide, dtype=float)
-        longest = int(np.argmax(half))
-        second = float(np.sort(half)[-2])
-        pieces = max(1, math.ceil(half[longest] / second))
-        bounding = float(np.linalg.norm(half))
-    elif kind == "Cylinder":
-        half = np.array([shape.radius, shape.halfLength, 0.0])
-        longest = 2
-        pieces = max(1, math.ceil(shape.halfLength / shape.radius))
-        bounding = math.hypot(shape.radius, shape.halfLength)
-    else:
-        raise CollisionModelError(name, f"shape {kind} is not supported (box or cylinder)")
-    length = half[longest] if kind == "Box" else shape.halfLength
-    piece_half = length / pieces
-    centres = np.zeros((pieces, 3))
-    centres[:, longest] = -length + piece_half * (2 * np.arange(pieces) + 1)
-    if kind == "Box":
-        sub = half.copy()
-        sub[longest] = piece_half
-        radius = float(np.linalg.norm(sub))
-    else:
-        radius = math.hypot(shape.radius, piece_half)
-    placement = np.array(geometry_object.placement.homogeneous)
-    joint = int(geometry_object.parentJoint)
-    reach = np.zeros(model.nq)
-    # Distance of any point of the primitive from joint j's origin (on its axis), bounded by the
-    # chain of joint offsets from j down to the primitive's joint plus the primitive's extent.
-    chain = float(np.linalg.norm(placement[:3, 3])) + bounding
-    current = joint
-    while current > 0:
-        reach[model.joints[current].idx_q] = chain
-        chain += float(np.linalg.norm(joint_placements[current][:3, 3]))
-        current = model.parents[current]
-    for array in (placement, half, centres, reach):
-        array.setflags(write=False)
-    link = model.frames[geometry_object.parentFrame].name
-    return LinkPrimitive(name, link, joint, placement, kind.lower(), half, centres, radius, reach)
-
-
-def _fcl_shape(primitive: LinkPrimitive) -> Any:
-    import fcl
-
-    if primitive.kind == "box":
-        return fcl.Box(*(2.0 * primitive.half_extents).tolist())
-    radius, half_length, _ = primitive.half_extents.tolist()
-    return fcl.Cylinder(radius, 2.0 * half_length)
-
-
-def _obstacle_arrays(obstacles: tuple[Obstacle, ...]) -> tuple[np.ndarray, ...]:
-    """Obstacle kinds, centres (O, 3), rotations (O, 3, 3), half sizes (O, 3) for the kernels."""
-    kinds = np.zeros(len(obstacles), dtype=np.int64)
-    sizes = np.zeros((len(obstacles), 3))
-    for o, obstacle in enumerate(obstacles):
-        if isinstance(obstacle, BoxObstacle):
-            kinds[o], sizes[o] = _kernels.BOX, obstacle.size / 2.0
-        elif isinstance(obstacle, SphereObstacle):
-            kinds[o], sizes[o, 0] = _kernels.SPHERE, obstacle.radius
-        else:
-            kinds[o] = _kernels.CYLINDER
-            sizes[o, :2] = obstacle.radius, obstacle.length / 2.0
-    centres = np.array([o.centre for o in obstacles]).reshape(-1, 3)
-    rotations = np.array([np.asarray(o.rotation) for o in obstacles]).reshape(-1, 3, 3)
-    return kinds, centres, rotations, sizes
-
-
-def signed_distance(obstacle: Obstacle, points: np.ndarray) -> np.ndarray:
-    """Exact signed distance of points (..., 3) to an obstacle, in [m] (negative inside)."""
-    local = (points - obstacle.centre) @ np.asarray(obstacle.rotation)
-    if isinstance(obstacle, SphereObstacle):
-        return np.linalg.norm(local, axis=-1) - obstacle.radius
-    if isinstance(obstacle, BoxObstacle):
-        excess = np.abs(local) - obstacle.size / 2.0
-    elif isinstance(obstacle, CylinderObstacle):
-        excess = np.stack(
-            (
-                np.linalg.norm(local[..., :2], axis=-1) - obstacle.radius,
-                np.abs(local[..., 2]) - obstacle.length / 2.0,
-            ),
-            axis=-1,
-        )
-    outside = np.linalg.norm(np.maximum(excess, 0.0), axis=-1)
-    return outside + np.minimum(excess.max(axis=-1), 0.0)
+__all__ = ["CollisionWorld", "LinkPrimitive", "signed_distance"]

@@ -70,6 +70,7 @@ def _units(args: argparse.Namespace) -> dict[str, str]:
 def handle_fk(args: argparse.Namespace) -> int:
     """Print the tool pose of the given joint angles."""
     from lynxplan.arm import load_arm
+    from lynxplan.arm.closed_form import tool_pose  # one pose: no numba import, fast start
 
     if robots_cmd.wants_robot(args):
         return robots_cmd.handle_robot_fk(args)
@@ -77,7 +78,7 @@ def handle_fk(args: argparse.Namespace) -> int:
     if len(args.q) != 5:
         raise InputError(f"fk: expected 5 joint angles q1..q5, got {len(args.q)}")
     q = np.array([parse_finite(text, f"q{i + 1}") for i, text in enumerate(args.q)])
-    T = load_arm().fk(q * angle_factor(units["angle"]))
+    T = tool_pose(q * angle_factor(units["angle"]), load_arm().geometry)
     T[:3, 3] /= length_factor(units["length"])
     if args.json:
         print_json({"T": T, "units": units})

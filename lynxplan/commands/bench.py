@@ -15,6 +15,12 @@ def register(subparsers: Any) -> None:
     parser.add_argument(
         "--section", action="append", choices=sorted(SECTIONS), help="run only these sections"
     )
+    parser.add_argument(
+        "--cold",
+        action="store_true",
+        help="fresh-process start-up times only (section cold): fk, run ok_task --quick, "
+        "import pinocchio",
+    )
     parser.add_argument("--quick", action="store_true", help="fewer repeats (smoke test)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(handler=handle)
@@ -22,7 +28,8 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the benchmark and print the figures."""
-    figures = run_sections(args.section, quick=args.quick)
+    sections = ["cold"] if args.cold else args.section
+    figures = run_sections(sections, quick=args.quick)
     if args.json:
         print_json({"figures": [f._asdict() for f in figures]})
         return 0

@@ -93,7 +93,7 @@ def jacobian_row(
 @numba.njit(cache=True, nogil=True)
 def det3(a: np.ndarray) -> float:
     """Determinant of a 3x3 matrix by cofactors along the first row."""
-    return (
+    return float(
         a[0, 0] * (a[1, 1] * a[2, 2] - a[1, 2] * a[2, 1])
         - a[0, 1] * (a[1, 0] * a[2, 2] - a[1, 2] * a[2, 0])
         + a[0, 2] * (a[1, 0] * a[2, 1] - a[1, 1] * a[2, 0])

@@ -35,6 +35,7 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._arrays import as_rows
 from lynxplan.constants import (
     PARALLEL_FK_DUPLICATE_TOLERANCE,
     PARALLEL_FK_UNIT_CIRCLE_TOLERANCE,
@@ -82,12 +83,7 @@ class ParallelFKResult(NamedTuple):
 
 
 def _as_thetas(theta: np.ndarray) -> np.ndarray:
-    array = np.asarray(theta, dtype=float)
-    if array.ndim not in (1, 2) or array.shape[-1] != 3:
-        raise ShapeError("theta", "(3,) or (N, 3)", array.shape)
-    if not np.all(np.isfinite(array)):
-        raise NonFiniteInputError("theta")
-    return array.reshape(-1, 3)
+    return as_rows(theta, 3, "theta")
 
 
 @numba.njit(cache=True, nogil=True)
@@ -201,6 +197,83 @@ def _verify(pose: np.ndarray, theta: np.ndarray, legs: LegConstants) -> tuple[fl
 
 
 @numba.njit(cache=True, nogil=True)
+def _sextic_roots(c: np.ndarray) -> np.ndarray:
+    """Roots of the polynomial ``c`` (7,), highest power first, as the companion matrix's
+    eigenvalues after trimming negligible end coefficients (a lower degree); may be empty."""
+    scale = 0.0
+    for k in range(7):
+        scale = max(scale, abs(c[k]))
+    first, last = 0, 6
+    while first < 7 and abs(c[first]) <= 1e-10 * scale:
+        first += 1
+    while last > first and abs(c[last]) <= 1e-10 * scale:
+        last -= 1
+    degree = max(last - first, 0)
+    companion = np.zeros((degree, degree), dtype=np.complex128)
+    for j in range(degree):
+        companion[0, j] = -c[first + 1 + j] / c[first]
+    for j in range(degree - 1):
+        companion[j + 1, j] = 1.0
+    if degree == 0:
+        return np.empty(0, dtype=np.complex128)
+    return np.linalg.eigvals(companion)
+
+
+@numba.njit(cache=True, nogil=True)
+def _centre_from_legs_a_b(
+    elbow: np.ndarray, alpha: float, legs: LegConstants, pose: np.ndarray
+) -> None:
+    """``pose[:2]``: the intersection of leg circles A and B (radius L about ``A_i(alpha)``) that
+    lies closest to circle C; ``pose[2] = alpha``."""
+    _, phase, rp, _, el = legs
+    ca, sa = math.cos(alpha), math.sin(alpha)
+    ax0, ay0 = anchor(elbow, ca, sa, phase, rp, 0)
+    ax1, ay1 = anchor(elbow, ca, sa, phase, rp, 1)
+    ax2, ay2 = anchor(elbow, ca, sa, phase, rp, 2)
+    chx, chy = ax1 - ax0, ay1 - ay0
+    length = max(math.sqrt(chx * chx + chy * chy), 1e-300)
+    half = math.sqrt(max(el * el - 0.25 * length * length, 0.0))
+    best = math.inf
+    for side in (1.0, -1.0):
+        cx = 0.5 * (ax0 + ax1) - side * half * chy / length
+        cy = 0.5 * (ay0 + ay1) + side * half * chx / length
+        miss = abs(math.sqrt((cx - ax2) ** 2 + (cy - ay2) ** 2) - el)
+        if miss < best:
+            best = miss
+            pose[0], pose[1] = cx, cy
+    pose[2] = alpha
+
+
+@numba.njit(cache=True, nogil=True)
+def _insert_mode(
+    n: int,
+    pose: np.ndarray,
+    mode: int,
+    error: float,
+    duplicate_tolerance: float,
+    out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+) -> None:
+    """Add an assembly mode of solve n to ``out`` = (poses, modes, errors, counts), kept sorted by
+    platform angle, unless a pose within ``duplicate_tolerance`` is already there."""
+    poses, modes, errors, counts = out
+    tol = duplicate_tolerance
+    for m in range(counts[n]):
+        near = math.hypot(poses[n, m, 0] - pose[0], poses[n, m, 1] - pose[1])
+        if near <= tol and abs(_wrap(poses[n, m, 2] - pose[2])) <= tol:
+            return
+    m = counts[n]  # insertion, sorted by platform angle
+    while m > 0 and poses[n, m - 1, 2] > pose[2]:
+        poses[n, m] = poses[n, m - 1]
+        modes[n, m] = modes[n, m - 1]
+        errors[n, m] = errors[n, m - 1]
+        m -= 1
+    poses[n, m, 0], poses[n, m, 1], poses[n, m, 2] = pose[0], pose[1], pose[2]
+    modes[n, m] = mode
+    errors[n, m] = error
+    counts[n] += 1
+
+
+@numba.njit(cache=True, nogil=True)
 def fk_kernel(
     coefficients: np.ndarray,
     elbow: np.ndarray,
@@ -213,75 +286,22 @@ def fk_kernel(
     counts: np.ndarray,
 ) -> None:
     """Assembly modes of each solve n from its sextic ``coefficients[n]`` (7,), highest power
-    first: roots (companion eigenvalues, negligible end coefficients trimmed) on the unit circle
-    -> centre from leg circles A and B -> Newton -> IK check -> dedupe -> sort by alpha.
-    Writes ``poses`` (N, 6, 3), ``modes`` (N, 6), ``errors`` (N, 6), ``counts`` (N,);
-    ``tolerances`` = (unit circle, IK verification, duplicate)."""
-    _, phase, rp, _, el = legs
+    first: roots on the unit circle -> centre from leg circles A and B -> Newton -> IK check ->
+    dedupe -> sort by alpha. Writes ``poses`` (N, 6, 3), ``modes`` (N, 6), ``errors`` (N, 6),
+    ``counts`` (N,); ``tolerances`` = (unit circle, IK verification, duplicate)."""
     pose = np.empty(3)
-    ax = np.empty(3)
-    ay = np.empty(3)
+    out = (poses, modes, errors, counts)
     for n in range(coefficients.shape[0]):
         counts[n] = 0
-        c = coefficients[n]
-        scale = 0.0
-        for k in range(7):
-            scale = max(scale, abs(c[k]))
-        first, last = 0, 6
-        while first < 7 and abs(c[first]) <= 1e-10 * scale:
-            first += 1
-        while last > first and abs(c[last]) <= 1e-10 * scale:
-            last -= 1
-        degree = last - first
-        if degree <= 0:
-            continue
-        companion = np.zeros((degree, degree), dtype=np.complex128)
-        for j in range(degree):
-            companion[0, j] = -c[first + 1 + j] / c[first]
-        for j in range(degree - 1):
-            companion[j + 1, j] = 1.0
-        for z in np.linalg.eigvals(companion):
+        for z in _sextic_roots(coefficients[n]):
             if abs(abs(z) - 1.0) >= tolerances[0]:
                 continue
-            alpha = math.atan2(z.imag, z.real)
-            ca, sa = math.cos(alpha), math.sin(alpha)
-            for i in range(3):
-                ax[i], ay[i] = anchor(elbow[n], ca, sa, phase, rp, i)
-            # Centre: the intersection of leg circles A and B that lies closest to circle C.
-            chx, chy = ax[1] - ax[0], ay[1] - ay[0]
-            length = max(math.sqrt(chx * chx + chy * chy), 1e-300)
-            half = math.sqrt(max(el * el - 0.25 * length * length, 0.0))
-            best = math.inf
-            for side in (1.0, -1.0):
-                cx = 0.5 * (ax[0] + ax[1]) - side * half * chy / length
-                cy = 0.5 * (ay[0] + ay[1]) + side * half * chx / length
-                miss = abs(math.sqrt((cx - ax[2]) ** 2 + (cy - ay[2]) ** 2) - el)
-                if miss < best:
-                    best = miss
-                    pose[0], pose[1] = cx, cy
-            pose[2] = alpha
+            _centre_from_legs_a_b(elbow[n], math.atan2(z.imag, z.real), legs, pose)
             _closure_newton(elbow[n], pose, legs)
             pose[2] = _wrap(pose[2])
             error, mode = _verify(pose, theta[n], legs)
-            if not error <= tolerances[1] or counts[n] >= 6:
-                continue
-            duplicate = False
-            for m in range(counts[n]):
-                near = math.hypot(poses[n, m, 0] - pose[0], poses[n, m, 1] - pose[1])
-                if near <= tolerances[2] and abs(_wrap(poses[n, m, 2] - pose[2])) <= tolerances[2]:
-                    duplicate = True
-            if duplicate:
-                continue
-            m = counts[n]  # insertion, sorted by platform angle
-            while m > 0 and poses[n, m - 1, 2] > pose[2]:
-                poses[n, m] = poses[n, m - 1]
-                modes[n, m] = modes[n, m - 1]
-                errors[n, m] = errors[n, m - 1]
-                m -= 1
-            poses[n, m, 0], poses[n, m, 1], poses[n, m, 2] = pose[0], pose[1], pose[2]
-            modes[n, m] = mode
-            errors[n, m] = error
-            counts[n] += 1
+            if error <= tolerances[1] and counts[n] < 6:
+                _insert_mode(n, pose, mode, error, tolerances[2], out)
 
 
 def solve_fk_batch(

@@ -56,7 +56,7 @@ class ParallelGeometry:
     @property
     def base_centre(self) -> np.ndarray:
         """Centroid of the base triangle, shape (2,), in [m]."""
-        return self.base_joints.mean(axis=0)
+        return np.asarray(self.base_joints.mean(axis=0))
 
     @property
     def leg_reach(self) -> tuple[float, float]:

@@ -17,10 +17,10 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._arrays import as_rows
 from lynxplan.constants import ACOS_CLAMP_TOLERANCE
 from lynxplan.exceptions import (
     LegUnreachableError,
-    NonFiniteInputError,
     ShapeError,
     leg_unreachable_reason,
 )
@@ -120,12 +120,7 @@ def as_poses(
     poses: np.ndarray | list[float] | tuple[float, ...], name: str = "poses"
 ) -> np.ndarray:
     """Validate poses: shape (3,) or (N, 3), finite -> float array (N, 3)."""
-    array = np.asarray(poses, dtype=float)
-    if array.ndim not in (1, 2) or array.shape[-1] != 3:
-        raise ShapeError(name, "(3,) or (N, 3)", array.shape)
-    if not np.all(np.isfinite(array)):
-        raise NonFiniteInputError(name)
-    return np.ascontiguousarray(array.reshape(-1, 3))
+    return as_rows(poses, 3, name)
 
 
 def solve_ik_batch(
@@ -165,7 +160,7 @@ def solve_ik(pose: np.ndarray, geometry: ParallelGeometry = _DEFAULT_GEOMETRY) -
     for i in range(3):
         if not result.reachable[0, i]:
             raise LegUnreachableError(LEG_NAMES[i], float(result.leg_distance[0, i]), *result.reach)
-    return result.angles[0]
+    return np.asarray(result.angles[0])
 
 
 def platform_joints(

@@ -120,7 +120,7 @@ def grid_axes(
         raise InputError(f"workspace region must have min < max. Got: x {x_range}, y {y_range} m")
     axes = []
     for lo, hi in (x_range, y_range):
-        n = int(math.floor((hi - lo) / step + 1e-9)) + 1
+        n = math.floor((hi - lo) / step + 1e-9) + 1
         if n > 20_000:
             raise InputError(
                 f"workspace grid step {step * 1e3:g} mm gives {n} points per axis (at most 20000)"

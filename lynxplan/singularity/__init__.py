@@ -1,23 +1,21 @@
 """Singularities of the 5-DOF arm: measures, classification, resolved-rate strategies (Part 5)."""
 
-from lynxplan.singularity.measures import (
-    NAMED_TASKS,
-    ROW_NAMES,
+from lynxplan.singularity.classify import (
     Singularity,
     SingularityDistance,
-    Task,
-    condition_number,
-    extended_jacobian,
-    make_task,
-    manipulability,
-    manipulability_and_gradient,
-    manipulability_gradient,
     max_manipulability,
     near_singularities,
     nearest_singularity,
     singular_conditions,
-    singular_values,
     singularity_distances,
+)
+from lynxplan.singularity.measures import (
+    condition_number,
+    extended_jacobian,
+    manipulability,
+    manipulability_and_gradient,
+    manipulability_gradient,
+    singular_values,
     task_jacobian,
     task_jacobian_derivative,
 )
@@ -34,6 +32,7 @@ from lynxplan.singularity.resolved_rate import (
     run_reference,
     run_resolved_rate,
 )
+from lynxplan.singularity.tasks import NAMED_TASKS, ROW_NAMES, Task, make_task
 
 __all__ = [
     "NAMED_TASKS",
@@ -43,24 +42,24 @@ __all__ = [
     "ResolvedRateProblem",
     "ResolvedRateRun",
     "RunMetrics",
-    "Strategy",
-    "TrParameters",
-    "max_manipulability",
-    "run_all",
-    "run_metrics",
-    "run_reference",
-    "run_resolved_rate",
     "Singularity",
     "SingularityDistance",
+    "Strategy",
     "Task",
+    "TrParameters",
     "condition_number",
     "extended_jacobian",
     "make_task",
     "manipulability",
     "manipulability_and_gradient",
     "manipulability_gradient",
+    "max_manipulability",
     "near_singularities",
     "nearest_singularity",
+    "run_all",
+    "run_metrics",
+    "run_reference",
+    "run_resolved_rate",
     "singular_conditions",
     "singular_values",
     "singularity_distances",

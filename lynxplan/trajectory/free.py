@@ -19,7 +19,7 @@ def as_configuration(q: np.ndarray | list[float], name: str) -> np.ndarray:
     array = np.asarray(q, dtype=float)
     if array.shape != (5,):
         raise ShapeError(name, "(5,)", array.shape)
-    out = as_configurations(array, name)[0].copy()
+    out: np.ndarray = as_configurations(array, name)[0].copy()
     out.setflags(write=False)
     return out
 
@@ -64,7 +64,7 @@ class FreeSegment:
     def joint_path(self, s: np.ndarray) -> np.ndarray:
         """Geometric joint path at path parameters ``s`` (m,) in [0, 1]; shape (m, 5) in [rad]."""
         s = np.asarray(s, dtype=float)
-        return self.q_start + np.multiply.outer(s, self.q_end - self.q_start)
+        return np.asarray(self.q_start + np.multiply.outer(s, self.q_end - self.q_start))
 
     def path_derivatives(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """``dq/ds`` and ``d2q/ds2`` at ``s`` (m,), each shape (m, 5), in [rad]."""

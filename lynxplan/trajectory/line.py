@@ -216,7 +216,7 @@ def _nearest_solution(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -
     ik = solve_ik_batch(T[None], limits=limits.joint_limits)
     if ik.status[0] != 0:
         raise PathNotFollowableError(1.0, float(ik.reach_miss[0]))
-    return select_continuous(ik.q, ik.within_limits, q_near)[0][0]
+    return np.asarray(select_continuous(ik.q, ik.within_limits, q_near)[0][0])
 
 
 def line_segment(

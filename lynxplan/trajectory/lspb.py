@@ -19,6 +19,7 @@ from dataclasses import dataclass
 from typing import NamedTuple, TypeVar
 
 import numpy as np
+from numba.extending import register_jitable
 
 from lynxplan.exceptions import TimingError
 
@@ -120,16 +121,19 @@ def lspb(
 
 
 # Report eqs.: the three pieces of the normalised law (SPEC Part 2), at report time ``time``;
-# each returns (s, ds/dt, d2s/dt2) for floats or arrays.
+# each returns (s, ds/dt, d2s/dt2) for floats or arrays, from Python and from numba kernels.
+@register_jitable
 def _first_blend(time: _Time, big_t: float, tau: float) -> tuple[_Time, _Time, float]:
     start = time + tau
     return start**2 / (4 * big_t * tau), start / (2 * big_t * tau), 1.0 / (2 * big_t * tau)
 
 
+@register_jitable
 def _cruise(time: _Time, big_t: float) -> tuple[_Time, float, float]:
     return time / big_t, 1.0 / big_t, 0.0
 
 
+@register_jitable
 def _last_blend(time: _Time, big_t: float, tau: float) -> tuple[_Time, _Time, float]:
     end = time - big_t + tau
     return (
@@ -139,10 +143,12 @@ def _last_blend(time: _Time, big_t: float, tau: float) -> tuple[_Time, _Time, fl
     )
 
 
-def unit_lspb_scalar(t: float, timing: LspbTiming) -> tuple[float, float, float]:
-    """:func:`unit_lspb` at one time since the start ``t`` in [s], in plain floats (for
-    per-sample loops): ``(s, ds/dt [1/s], d2s/dt2 [1/s^2])``."""
-    tau, big_t = timing.tau, timing.cruise_parameter
+@register_jitable
+def lspb_scalar(t: float, tt: float, ta: float) -> tuple[float, float, float]:
+    """The normalised law at one time since the start ``t`` for total time ``tt`` and blend
+    ``ta`` in [s] (``tt >= 2 ta > 0``, unchecked), in plain floats: ``(s, ds/dt [1/s],
+    d2s/dt2 [1/s^2])``; callable from numba kernels and per-sample loops."""
+    tau, big_t = 0.5 * ta, tt - ta
     report_time = t - tau
     time = min(max(report_time, -tau), big_t + tau)
     if time >= big_t - tau:
@@ -154,6 +160,11 @@ def unit_lspb_scalar(t: float, timing: LspbTiming) -> tuple[float, float, float]
     if report_time < -tau or report_time > big_t + tau:
         return s, 0.0, 0.0
     return s, sd, sdd
+
+
+def unit_lspb_scalar(t: float, timing: LspbTiming) -> tuple[float, float, float]:
+    """:func:`unit_lspb` at one time since the start ``t`` in [s], in plain floats."""
+    return lspb_scalar(t, timing.tt, timing.ta)
 
 
 def lspb_since_start(

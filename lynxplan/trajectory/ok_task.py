@@ -11,7 +11,7 @@ from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import Plan, SegmentSpec, build_plan
 
 if TYPE_CHECKING:
-    from lynxplan.collision.obstacles import BoxObstacle
+    from lynxplan.collision.obstacles import Obstacle
 
 #: Waypoint names, joint angles in [deg] and the motion to the next waypoint (SPEC Part 3).
 OK_TASK_WAYPOINTS: tuple[tuple[str, tuple[float, float, float, float, float], str], ...] = (
@@ -43,10 +43,11 @@ REPORT_TIMING = LspbTiming(2.0, 0.5)
 
 def ok_task_configurations() -> np.ndarray:
     """The 14 waypoints' joint angles, shape (14, 5), in [rad]."""
-    return np.radians(np.array([row[1] for row in OK_TASK_WAYPOINTS], dtype=float))
+    degrees = np.array([row[1] for row in OK_TASK_WAYPOINTS], dtype=float)
+    return np.asarray(np.radians(degrees))
 
 
-def ok_task_walls() -> list[BoxObstacle]:
+def ok_task_walls() -> list[Obstacle]:
     """The two walls as axis-aligned boxes, in [m]."""
     from lynxplan.collision.obstacles import axis_aligned_box
     from lynxplan.units import INCH

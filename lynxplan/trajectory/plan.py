@@ -100,7 +100,7 @@ class Plan:
         """
         if not (math.isfinite(rate) and rate > 0):
             raise InputError(f"sample rate must be a positive number of Hz. Got: {rate}")
-        count = int(math.floor(self.duration * rate + 1e-9)) + 1
+        count = math.floor(self.duration * rate + 1e-9) + 1
         t = np.arange(count) / rate
         if t[-1] < self.duration - 1e-12:
             t = np.append(t, self.duration)
@@ -127,7 +127,7 @@ def _ik_nearest(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.n
     ik = solve_ik_batch(np.asarray(T, dtype=float)[None], limits=limits.joint_limits)
     if ik.status[0] != 0:
         raise PathNotFollowableError(1.0, float(ik.reach_miss[0]), "target pose")
-    return select_continuous(ik.q, ik.within_limits, q_near)[0][0]
+    return np.asarray(select_continuous(ik.q, ik.within_limits, q_near)[0][0])
 
 
 def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) -> Segment:

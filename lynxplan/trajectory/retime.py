@@ -102,7 +102,7 @@ class ProfileStats(NamedTuple):
 
 def sample_times(duration: float, rate: float) -> np.ndarray:
     """Times 0, 1/rate, ... and the duration itself, shape (N,), in [s]."""
-    count = int(math.floor(duration * rate + 1e-9)) + 1
+    count = math.floor(duration * rate + 1e-9) + 1
     t = np.arange(count) / rate
     return t if t[-1] >= duration - 1e-12 else np.append(t, duration)
 
@@ -183,9 +183,9 @@ def toppra_profile(
         RetimingError: toppra found no parameterisation, or the samples still exceed the limits
             after :data:`TOPPRA_RESCALE_ROUNDS` slow-downs.
     """
-    import toppra
-    import toppra.algorithm
-    import toppra.constraint
+    from lynxplan._toppra import import_toppra
+
+    toppra = import_toppra()
 
     if isinstance(segment, LineSegment):
         s, waypoints = segment.grid.s, segment.grid.q

@@ -1,105 +1,62 @@
-"""Small batch rotation helpers: quaternions (w, x, y, z), axis-angle, Paul's drive transform."""
+"""Batch rotation helpers on scipy's ``Rotation``/``Slerp``: quaternions (w, x, y, z), axis-angle,
+the report's component blend and Paul's drive transform."""
 
 from __future__ import annotations
 
 import numpy as np
 
 
-def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
-    """Unit quaternions (w, x, y, z) of rotation matrices, shape (..., 3, 3) -> (..., 4).
+def _wxyz(xyzw: np.ndarray) -> np.ndarray:
+    return np.concatenate([xyzw[..., 3:], xyzw[..., :3]], axis=-1)
 
-    Uses the largest of the four candidate components (numerically safe for every rotation).
-    """
+
+def _xyzw(wxyz: np.ndarray) -> np.ndarray:
+    return np.concatenate([wxyz[..., 1:], wxyz[..., :1]], axis=-1)
+
+
+def matrix_to_quaternion(R: np.ndarray) -> np.ndarray:
+    """Unit quaternions (w, x, y, z), w >= 0, of rotation matrices, shape (..., 3, 3) -> (..., 4)
+    (scipy's ``Rotation.from_matrix``)."""
+    from scipy.spatial.transform import Rotation
+
     R = np.asarray(R, dtype=float)
-    m00, m11, m22 = R[..., 0, 0], R[..., 1, 1], R[..., 2, 2]
-    candidates = np.stack(
-        [
-            np.stack(
-                [
-                    1 + m00 + m11 + m22,
-                    R[..., 2, 1] - R[..., 1, 2],
-                    R[..., 0, 2] - R[..., 2, 0],
-                    R[..., 1, 0] - R[..., 0, 1],
-                ],
-                -1,
-            ),
-            np.stack(
-                [
-                    R[..., 2, 1] - R[..., 1, 2],
-                    1 + m00 - m11 - m22,
-                    R[..., 0, 1] + R[..., 1, 0],
-                    R[..., 0, 2] + R[..., 2, 0],
-                ],
-                -1,
-            ),
-            np.stack(
-                [
-                    R[..., 0, 2] - R[..., 2, 0],
-                    R[..., 0, 1] + R[..., 1, 0],
-                    1 - m00 + m11 - m22,
-                    R[..., 1, 2] + R[..., 2, 1],
-                ],
-                -1,
-            ),
-            np.stack(
-                [
-                    R[..., 1, 0] - R[..., 0, 1],
-                    R[..., 0, 2] + R[..., 2, 0],
-                    R[..., 1, 2] + R[..., 2, 1],
-                    1 - m00 - m11 + m22,
-                ],
-                -1,
-            ),
-        ],
-        -2,
-    )  # (..., 4 candidates, 4 components); candidate i has component i = 4 q_i^2 / (2 |q_i|)
-    diagonal = np.stack(
-        [1 + m00 + m11 + m22, 1 + m00 - m11 - m22, 1 - m00 + m11 - m22, 1 - m00 - m11 + m22], -1
-    )
-    best = np.argmax(diagonal, axis=-1)
-    chosen = np.take_along_axis(candidates, best[..., None, None], axis=-2)[..., 0, :]
-    quaternion = chosen / np.linalg.norm(chosen, axis=-1, keepdims=True)
-    return np.where(quaternion[..., :1] < 0, -quaternion, quaternion)
+    quaternion = Rotation.from_matrix(R.reshape(-1, 3, 3)).as_quat(canonical=True)
+    return _wxyz(quaternion).reshape(*R.shape[:-2], 4)
 
 
 def quaternion_to_matrix(quaternion: np.ndarray) -> np.ndarray:
     """Rotation matrices of quaternions (w, x, y, z), shape (..., 4) -> (..., 3, 3).
 
-    The quaternions are normalised first (a component blend is not unit-norm).
+    The quaternions are normalised first (a component blend is not unit-norm); scipy's
+    ``Rotation.from_quat``.
     """
+    from scipy.spatial.transform import Rotation
+
     qn = np.asarray(quaternion, dtype=float)
-    qn = qn / np.linalg.norm(qn, axis=-1, keepdims=True)
-    w, x, y, z = qn[..., 0], qn[..., 1], qn[..., 2], qn[..., 3]
-    return np.stack(
-        [
-            np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
-            np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
-            np.stack([2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)], -1),
-        ],
-        -2,
-    )
+    matrices = Rotation.from_quat(_xyzw(qn.reshape(-1, 4))).as_matrix()
+    return np.asarray(matrices.reshape(*qn.shape[:-1], 3, 3))
 
 
 def axis_angle_matrix(axis: np.ndarray, angle: np.ndarray) -> np.ndarray:
-    """Rodrigues rotations about unit ``axis`` (3,) by ``angle`` (m,) in [rad]; (m, 3, 3)."""
+    """Rotations about unit ``axis`` (3,) by ``angle`` (m,) in [rad]; (m, 3, 3) (scipy's
+    ``Rotation.from_rotvec``)."""
+    from scipy.spatial.transform import Rotation
+
     k = np.asarray(axis, dtype=float)
     angle = np.asarray(angle, dtype=float)
-    skew = np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
-    c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
-    return np.eye(3) * c + s * skew + (1 - c) * np.outer(k, k)
+    matrices = Rotation.from_rotvec(np.multiply.outer(angle, k)).as_matrix()
+    return np.asarray(matrices.reshape(-1, 3, 3))
 
 
 def slerp(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray:
-    """Shortest-arc spherical interpolation of unit quaternions (4,) at ``s`` (m,) -> (m, 4)."""
+    """Shortest-arc spherical interpolation of unit quaternions (4,) at ``s`` (m,) -> (m, 4)
+    (scipy's ``Slerp``); returned with the sign continuous from ``q0``."""
+    from scipy.spatial.transform import Rotation, Slerp
+
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
-    if q0 @ q1 < 0:
-        q1 = -q1
-    cosine = min(1.0, float(q0 @ q1))
-    theta = np.arccos(cosine)
-    s = np.asarray(s, dtype=float)[:, None]
-    if theta < 1e-9:
-        return q0 + s * (q1 - q0)
-    return (np.sin((1 - s) * theta) * q0 + np.sin(s * theta) * q1) / np.sin(theta)
+    ends = Rotation.from_quat(_xyzw(np.stack([q0, q1])))
+    out = _wxyz(Slerp([0.0, 1.0], ends)(np.asarray(s, dtype=float)).as_quat())
+    return np.where((out @ q0)[:, None] < 0.0, -out, out)
 
 
 def component_blend(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray:
@@ -111,7 +68,7 @@ def component_blend(q0: np.ndarray, q1: np.ndarray, s: np.ndarray) -> np.ndarray
     q0, q1 = np.asarray(q0, dtype=float), np.asarray(q1, dtype=float)
     if q0 @ q1 < 0:
         q1 = -q1
-    return q0 + np.asarray(s, dtype=float)[:, None] * (q1 - q0)
+    return np.asarray(q0 + np.asarray(s, dtype=float)[:, None] * (q1 - q0))
 
 
 def drive_parameters(T_a: np.ndarray, T_b: np.ndarray) -> tuple[np.ndarray, float, float, float]:

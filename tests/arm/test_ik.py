@@ -123,7 +123,7 @@ def test_nearest_selection_follows_reference(arm) -> None:
     q = np.radians([90, 40, -100, 80, 20])
     T = arm.fk(q)
     result = arm.ik(T)
-    elbow_down = [s for s in result.solutions if s.branch == "front/elbow-down"][0]
+    elbow_down = next(s for s in result.solutions if s.branch == "front/elbow-down")
     if elbow_down.within_limits:
         chosen = arm.ik(T, q_reference=elbow_down.q)
         np.testing.assert_allclose(chosen.q, elbow_down.q)
@@ -132,7 +132,8 @@ def test_nearest_selection_follows_reference(arm) -> None:
 
 def test_report_rule_selects_q2_nonnegative_q3_nonpositive(arm) -> None:
     result = arm.ik(arm.fk(np.radians([45, 30, -60, 90, 10])), select="report")
-    assert result.q[1] >= 0 and result.q[2] <= 0
+    assert result.q[1] >= 0
+    assert result.q[2] <= 0
 
 
 def test_no_solution_within_limits(arm) -> None:
@@ -204,7 +205,8 @@ def test_out_of_reach_reports_distance(arm) -> None:
         arm.ik(T)
     assert np.isclose(info.value.distance, 0.001, atol=1e-12)
     batch = arm.ik_batch(T)
-    assert batch.status[0] == IkStatus.OUT_OF_REACH and np.isnan(batch.q).all()
+    assert batch.status[0] == IkStatus.OUT_OF_REACH
+    assert np.isnan(batch.q).all()
 
 
 def test_orientation_projection_and_strict_mode(arm) -> None:
@@ -312,5 +314,6 @@ def test_two_solutions_within_limits_nearest_and_report_rule_differ(arm) -> None
     np.testing.assert_allclose(arm.ik(arm.fk(q), q_reference=q).q, q, atol=1e-12)
     np.testing.assert_allclose(arm.ik(arm.fk(q), q_reference=other.q).q, other.q, atol=1e-12)
     report = arm.ik(arm.fk(q), q_reference=other.q, select="report").q
-    assert report[1] >= 0 and report[2] <= 0
+    assert report[1] >= 0
+    assert report[2] <= 0
     np.testing.assert_allclose(report, q, atol=1e-12)  # the report's rule ignores the reference

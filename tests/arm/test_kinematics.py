@@ -142,3 +142,28 @@ def test_default_limits_match_the_urdf(arm) -> None:
     defaults = JointLimits()
     np.testing.assert_allclose(defaults.position, arm.limits.position, atol=1e-12)
     np.testing.assert_allclose(defaults.velocity, arm.limits.velocity, atol=0)
+
+
+def test_single_pose_formula_matches_the_batch_kernel() -> None:
+    from lynxplan.arm.closed_form import tool_pose
+    from lynxplan.arm.kinematics import forward_kinematics
+
+    rng = np.random.default_rng(42)
+    for q in rng.uniform(-3.0, 3.0, (50, 5)):
+        np.testing.assert_allclose(tool_pose(q), forward_kinematics(q), atol=1e-15)
+
+
+def test_fk_command_starts_without_numba() -> None:
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, contextlib, io\n"
+        "from lynxplan.cli import main\n"
+        "with contextlib.redirect_stdout(io.StringIO()):\n"
+        "    main(['fk', '0', '0.1', '0.2', '0.3', '0.4'])\n"
+        "print(sorted(m for m in ('numba', 'matplotlib', 'meshcat', 'toppra', 'pydantic', 'scipy')"
+        " if m in sys.modules))\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", out.stdout

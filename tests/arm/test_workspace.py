@@ -19,7 +19,8 @@ def test_report_grid_matches_report_steps(arm) -> None:
     grid = report_grid(arm.limits)
     # q1: 0..180 by 3 deg (61); q2: 0..150 by 12 deg (13); q3: -150..0 (13); q4: 0..180 (16).
     assert grid.shape == (61 * 13 * 13 * 16, 5)
-    assert (grid >= arm.limits.lower - 1e-12).all() and (grid <= arm.limits.upper + 1e-12).all()
+    assert (grid >= arm.limits.lower - 1e-12).all()
+    assert (grid <= arm.limits.upper + 1e-12).all()
     np.testing.assert_allclose(
         tool_positions(grid[::97], arm.geometry),
         forward_kinematics(grid[::97])[:, :3, 3],
@@ -59,7 +60,9 @@ def test_volume_converges_as_grid_is_refined(arm) -> None:
         for cell in (0.008, 0.004, 0.002)
     ]
     # Midpoint rule on a boundary-refined grid: about 1 % at 8 mm cells, well under at 2 mm.
-    assert errors[0] < 0.02 and errors[1] < 0.015 and errors[2] < 0.005
+    assert errors[0] < 0.02
+    assert errors[1] < 0.015
+    assert errors[2] < 0.005
 
 
 def test_envelope_and_reach(arm) -> None:

@@ -49,7 +49,8 @@ def test_ik_json_contract(capsys) -> None:
 def test_ik_without_all_lists_only_solutions_within_limits(capsys) -> None:
     code, out, _ = run_cli(capsys, "ik", "--pose", O2_POSE, "--deg", "--units", "in", "--json")
     data = json.loads(out)
-    assert code == 0 and all(s["within_limits"] for s in data["solutions"])
+    assert code == 0
+    assert all(s["within_limits"] for s in data["solutions"])
     assert data["selected"] == 0
 
 
@@ -83,7 +84,8 @@ def test_bad_input_is_one_line_and_nonzero(capsys, args: tuple[str, ...], messag
         code = exit_.code
     err = capsys.readouterr().err
     assert code != 0
-    assert err.count("\n") == 1 and "Traceback" not in err
+    assert err.count("\n") == 1
+    assert "Traceback" not in err
     assert re.search(message, err), err
 
 
@@ -96,14 +98,16 @@ def test_run_workspace_scenario_quick(capsys, tmp_path: Path) -> None:
     code, out, _ = run_cli(capsys, "run", str(scenario), "--out", str(tmp_path / "out"), "--quick")
     assert code == 0, out
     data = json.loads((tmp_path / "out" / "workspace.json").read_text())
-    assert data["units"]["length"] == "in" and data["volume"] > 8000
+    assert data["units"]["length"] == "in"
+    assert data["volume"] > 8000
 
 
 def test_failed_expectation_exits_one(capsys, tmp_path: Path) -> None:
     scenario = tmp_path / "ws.yaml"
     scenario.write_text("kind: workspace\nsamples: 20000\ncell: 0.4\nexpect: {max_reach: 10}\n")
     code, out, _ = run_cli(capsys, "run", str(scenario), "--out", str(tmp_path / "o"), "--quick")
-    assert code == 1 and "max_reach" in out
+    assert code == 1
+    assert "max_reach" in out
 
 
 def test_invalid_scenario_names_key_and_writes_nothing(capsys, tmp_path: Path) -> None:
@@ -113,14 +117,17 @@ def test_invalid_scenario_names_key_and_writes_nothing(capsys, tmp_path: Path) -
     scenario = tmp_path / "bad.yaml"
     scenario.write_text("kind: workspace\nsamples: many\n")
     code, _, err = run_cli(capsys, "run", str(scenario), "--out", str(out_dir))
-    assert code == 2 and "bad.yaml, samples:" in err
+    assert code == 2
+    assert "bad.yaml, samples:" in err
     assert (out_dir / "workspace.json").read_text() == "earlier run"
     scenario.write_text("kind: workspace\nsampels: 10\n")
     code, _, err = run_cli(capsys, "run", str(scenario), "--out", str(out_dir))
-    assert code == 2 and "sampels: Extra inputs are not permitted" in err
+    assert code == 2
+    assert "sampels: Extra inputs are not permitted" in err
     scenario.write_text("kind: teleport\n")
     code, _, err = run_cli(capsys, "run", str(scenario), "--out", str(out_dir))
-    assert code == 2 and "unknown kind 'teleport'" in err
+    assert code == 2
+    assert "unknown kind 'teleport'" in err
 
 
 def test_workspace_command_writes_plots_and_json(capsys, tmp_path: Path) -> None:
@@ -160,19 +167,23 @@ def test_duplicate_yaml_key_is_rejected(capsys, tmp_path: Path) -> None:
     scenario = tmp_path / "dup.yaml"
     scenario.write_text("kind: workspace\nsamples: 10\nsamples: 20\n")
     code, _, err = run_cli(capsys, "validate", str(scenario))
-    assert code == 2 and "line 3: invalid YAML: duplicate key 'samples'" in err
+    assert code == 2
+    assert "line 3: invalid YAML: duplicate key 'samples'" in err
 
 
 def test_run_time_error_names_the_scenario_file(capsys, tmp_path: Path) -> None:
     scenario = tmp_path / "far.yaml"
     scenario.write_text("kind: parallel_ik\npose: [2000, 180, 30]\n")
     code, _, err = run_cli(capsys, "run", str(scenario), "--quick", "--out", str(tmp_path / "o"))
-    assert code == 2 and f"scenario {scenario}" in err and "leg" in err
+    assert code == 2
+    assert f"scenario {scenario}" in err
+    assert "leg" in err
 
 
 def test_bench_smoke_json(capsys) -> None:
     code, out, _ = run_cli(capsys, "bench", "--section", "parallel", "--quick", "--json")
     assert code == 0
     figures = json.loads(out)["figures"]
-    assert figures and all(f["section"] == "parallel" for f in figures)
+    assert figures
+    assert all(f["section"] == "parallel" for f in figures)
     assert all(np.isfinite(f["value"]) and f["value"] > 0 for f in figures)

@@ -21,7 +21,7 @@ def joint_space_task(rate: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     Returns q (N, 5) [rad], t (N,) [s], segment index (N,).
     """
     q = np.radians(WAYPOINTS_DEG)
-    per = int(round(2.0 * rate))
+    per = round(2.0 * rate)
     s = np.arange(per) / per
     rows = [q[i] + s[:, None] * (q[i + 1] - q[i]) for i in range(len(q) - 1)]
     samples = np.vstack([*rows, q[-1:]])

@@ -34,7 +34,8 @@ def test_clearance_of_pen_above_a_block(arm):
     record = report.min_clearance
     assert record.clearance == pytest.approx(0.01, abs=DISTANCE_TOLERANCE)
     assert (record.link, record.geometry, record.obstacle) == ("gripper", "gripper_1", "block")
-    assert report.collision_free and report.contacts == ()
+    assert report.collision_free
+    assert report.contacts == ()
 
 
 def test_contact_with_penetration_depth(arm):
@@ -70,9 +71,11 @@ def test_fast_motion_through_a_thin_wall_is_caught_between_samples(arm):
     assert not report.collision_free
     assert report.refined_intervals >= 1
     contact = report.contacts[0]
-    assert contact.between_samples and contact.obstacle == "thin_wall"
+    assert contact.between_samples
+    assert contact.obstacle == "thin_wall"
     assert 0.0 < contact.time < 0.001
-    assert report.min_clearance.clearance <= 0.0 and report.min_clearance.sample == -1
+    assert report.min_clearance.clearance <= 0.0
+    assert report.min_clearance.sample == -1
     with pytest.raises(AssertionError, match=r"hits thin_wall .*\(between samples\)"):
         assert_collision_free(q, t, world)
 
@@ -82,7 +85,8 @@ def test_fast_motion_past_a_wall_is_certified(arm):
     q = np.stack([HOME, np.radians([90.0, 0, 0, 0, 0])])
     report = check_trajectory(world, q, [0.0, 0.001])
     assert report.refined_intervals >= 1  # the bound alone could not decide
-    assert report.collision_free and report.certified
+    assert report.collision_free
+    assert report.certified
     assert report.min_clearance.clearance > 0.05
 
 
@@ -95,7 +99,9 @@ def test_acceleration_margin_makes_the_test_stricter(arm):
     assert check_trajectory(world, q, [0.0, 0.01], acceleration_bound=1e3).collision_free
     # A margin larger than the clearance cannot be certified by bisecting the linear motion.
     hopeless = check_trajectory(world, q, [0.0, 0.01], acceleration_bound=1e6)
-    assert not hopeless.certified and not hopeless.collision_free and hopeless.contacts == ()
+    assert not hopeless.certified
+    assert not hopeless.collision_free
+    assert hopeless.contacts == ()
 
 
 @pytest.fixture(scope="module")
@@ -124,7 +130,8 @@ def test_segment_minima_equal_brute_force(spec_world):
 def test_spec_task_in_joint_space_is_collision_free_at_1khz(spec_world, arm):
     q, t, segment = joint_space_task(rate=1000.0)
     report = assert_collision_free(q, t, spec_world, clearance=0.005, segment=segment)
-    assert report.certified and len(report.segments) == 13
+    assert report.certified
+    assert len(report.segments) == 13
     assert report.min_clearance.obstacle == "wall_letters"
     assert_within_limits(q, arm)
 

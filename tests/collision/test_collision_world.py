@@ -240,7 +240,7 @@ def test_obstacle_errors(arm):
         BoxObstacle("b", [0, 0], [1, 1, 1])
     with pytest.raises(ShapeError, match=r"b.rotation must have shape \(3, 3\)"):
         BoxObstacle("b", [0, 0, 0], [1, 1, 1], np.eye(2))
-    with pytest.raises(NonFiniteInputError, match="b.size contains NaN"):
+    with pytest.raises(NonFiniteInputError, match=r"b\.size contains NaN"):
         BoxObstacle("b", [0, 0, 0], [1, np.nan, 1])
     with pytest.raises(InvalidObstacleError, match="axis vector must not be zero"):
         rotation_from_axis([0, 0, 0])

@@ -37,7 +37,8 @@ def test_ik_json(capsys: pytest.CaptureFixture[str]) -> None:
 def test_ik_text_and_negative_numbers(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["parallel", "ik", "260", "180", "-10"]) == 0
     out = capsys.readouterr().out
-    assert out.count("\n") == 9 and "8 ---" in out
+    assert out.count("\n") == 9
+    assert "8 ---" in out
 
 
 def test_fk_json(capsys: pytest.CaptureFixture[str]) -> None:
@@ -136,7 +137,8 @@ def test_cli_errors(
         argv = [*argv, "--out", str(tmp_path)]
     assert main(argv) == 2
     err = capsys.readouterr().err
-    assert message in err and err.count("\n") == 1
+    assert message in err
+    assert err.count("\n") == 1
 
 
 def test_ik_scenario(tmp_path: Path) -> None:

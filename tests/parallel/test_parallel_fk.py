@@ -85,7 +85,8 @@ def test_assembly_mode_counts_on_random_configurations_match_scan() -> None:
     results = solve_fk_batch(thetas)
     for theta, result in zip(thetas, results, strict=True):
         assert result.n_modes == count_by_scan(theta, samples=100_000)
-        assert result.n_modes % 2 == 0 and 2 <= result.n_modes <= 6
+        assert result.n_modes % 2 == 0
+        assert 2 <= result.n_modes <= 6
 
 
 @settings(max_examples=60, deadline=None)

@@ -75,7 +75,8 @@ def test_grid_agrees_with_ik_reachability() -> None:
     poses = np.column_stack([xx.ravel(), yy.ravel(), np.full(xx.size, w.alpha)])
     reachable = solve_ik_batch(poses).reachable.all(axis=1).reshape(w.mask.shape)
     np.testing.assert_array_equal(w.mask, reachable)
-    assert w.points > 0 and w.mode is None
+    assert w.points > 0
+    assert w.mode is None
 
 
 def test_report_grid_size() -> None:
@@ -107,7 +108,8 @@ def test_stack_matches_single_orientations() -> None:
         single = constant_orientation_workspace(alpha, step=2e-3)
         np.testing.assert_array_equal(stack.masks[k], single.mask)
         assert stack.areas_mm2[k] == pytest.approx(single.area_mm2)
-    assert np.all(stack.total >= stack.masks[0]) and np.all(stack.dexterous <= stack.masks[0])
+    assert np.all(stack.total >= stack.masks[0])
+    assert np.all(stack.dexterous <= stack.masks[0])
 
 
 @pytest.mark.parametrize(

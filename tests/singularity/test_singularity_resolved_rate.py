@@ -203,24 +203,28 @@ def test_path_reference_lspb() -> None:
 
 
 def test_parameter_errors(problem: ResolvedRateProblem) -> None:
-    with pytest.raises(SingularityParameterError, match="sigma = 0.0 must be a finite number > 0"):
+    with pytest.raises(
+        SingularityParameterError, match=r"sigma = 0\.0 must be a finite number > 0"
+    ):
         TrParameters(m_bar=1e-3, sigma=0.0, k_r=1.0)
-    with pytest.raises(SingularityParameterError, match="sigma = -1.0 must be"):
+    with pytest.raises(SingularityParameterError, match=r"sigma = -1\.0 must be"):
         TrParameters(m_bar=1e-3, sigma=-1.0, k_r=1.0)
     with pytest.raises(SingularityParameterError, match="m_bar = nan must be"):
         TrParameters(m_bar=float("nan"), sigma=1e-3, k_r=1.0)
-    with pytest.raises(SingularityParameterError, match="k_r = -2.0 must be a finite number >= 0"):
+    with pytest.raises(
+        SingularityParameterError, match=r"k_r = -2\.0 must be a finite number >= 0"
+    ):
         TrParameters(m_bar=1e-3, sigma=1e-3, k_r=-2.0)
-    with pytest.raises(SingularityParameterError, match="lambda_min = 0.0"):
+    with pytest.raises(SingularityParameterError, match=r"lambda_min = 0\.0"):
         TrParameters(m_bar=1e-3, sigma=1e-3, k_r=1.0, lambda_min=0.0)
-    with pytest.raises(SingularityParameterError, match="blend = 2.0 must be <= duration / 2"):
+    with pytest.raises(SingularityParameterError, match=r"blend = 2\.0 must be <= duration / 2"):
         PathReference.line([0, 0, 0], [1, 0, 0], 0.0, duration=3.0, blend=2.0)
     with pytest.raises(ShapeError, match=r"points must have shape \(M, 4\)"):
         PathReference(np.zeros((1, 4)), 1.0, 0.1)
     params = problem.parameters
     with pytest.raises(TaskError, match="rows among vx, vy, vz, pitch"):
         ResolvedRateProblem(problem.path, problem.q0, ["vx", "vy", "wz"], params)
-    with pytest.raises(SingularityParameterError, match="dt = 0.0 must be"):
+    with pytest.raises(SingularityParameterError, match=r"dt = 0\.0 must be"):
         ResolvedRateProblem(problem.path, problem.q0, "position", params, dt=0.0)
     with pytest.raises(InputError, match="velocity_limits must be finite and > 0"):
         ResolvedRateProblem(

@@ -137,7 +137,7 @@ def test_errors() -> None:
         line_segment(forward_kinematics(Q[1]), T0, Q[0], REPORT)
     far = T0.copy()
     far[:3, 3] = [0.0, 1.0, 0.0]  # 1 m away: out of reach
-    with pytest.raises(PathNotFollowableError, match="out of reach|leaves the arm's reach"):
+    with pytest.raises(PathNotFollowableError, match=r"out of reach|leaves the arm's reach"):
         line_segment(T0, far, Q[0], REPORT)
     with pytest.raises(ShapeError, match=r"q_start must have shape \(5,\)"):
         line_segment(T0, T0, Q[0][:4], REPORT)

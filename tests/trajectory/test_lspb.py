@@ -141,4 +141,5 @@ def test_invalid_timings_are_clear_errors(tt: float, ta: float, match: str) -> N
 @given(timings(), st.floats(-1.0, 12.0))
 def test_scalar_law_equals_the_vectorised_law(timing: LspbTiming, t: float) -> None:
     vectorised = unit_lspb(t, timing)
-    np.testing.assert_allclose(unit_lspb_scalar(t, timing), [float(v) for v in vectorised], atol=ATOL)
+    expected = [float(v) for v in vectorised]
+    np.testing.assert_allclose(unit_lspb_scalar(t, timing), expected, atol=ATOL)

@@ -70,7 +70,8 @@ def test_ruckig_cannot_meet_a_duration_below_its_jerk_limited_minimum() -> None:
     # A segment whose LSPB is shorter than ruckig's minimum reports it in the comparison.
     short = free_segment(Q[12], Q[13], LspbTiming(asked, asked / 4))
     compared = compare_segment(short, LIMITS, 500.0).stats["ruckig_lspb_duration"]
-    assert compared.duration_matched is False and compared.duration > asked
+    assert compared.duration_matched is False
+    assert compared.duration > asked
 
 
 def test_free_segment_comparison_orders_the_durations() -> None:
@@ -139,7 +140,8 @@ def test_toppra_overshoot_is_removed_by_a_uniform_slow_down(monkeypatch) -> None
     profile = toppra_profile(line, LIMITS, 1000.0)
     stats = profile_stats("toppra", profile, LIMITS)
     assert stats.time_scale > 1.05
-    assert stats.velocity_ratio <= TOPPRA_SLACK and stats.acceleration_ratio <= TOPPRA_SLACK
+    assert stats.velocity_ratio <= TOPPRA_SLACK
+    assert stats.acceleration_ratio <= TOPPRA_SLACK
     assert stats.violations == ()
     # Acceleration-limited: slowing by k divides the acceleration by k^2, so the raw peak was
     # about k^2 times the limit (the sampled active limit is met again after the slow-down).
@@ -179,5 +181,5 @@ def test_whole_plan_totals() -> None:
 
 
 def test_ruckig_failure_is_a_retiming_error() -> None:
-    with pytest.raises(RetimingError, match="ruckig found no trajectory: .*target position"):
+    with pytest.raises(RetimingError, match=r"ruckig found no trajectory: .*target position"):
         ruckig_profile(np.zeros(5), np.array([np.nan, 0, 0, 0, 0]), LIMITS, 100.0)

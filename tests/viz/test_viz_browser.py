@@ -43,7 +43,7 @@ _orange, _neutral = orange, neutral
 
 
 def _window(mask: np.ndarray, centre: tuple[float, float], half: int) -> np.ndarray:
-    col, row = int(round(centre[0])), int(round(centre[1]))
+    col, row = round(centre[0]), round(centre[1])
     return mask[max(row - half, 0) : row + half, max(col - half, 0) : col + half]
 
 
@@ -57,9 +57,9 @@ def screenshots(arm, tmp_path_factory):
     q = np.stack([POSE, POSE])
     t = np.array([0.0, 1.0])
     tip = arm.fk(q)[:, :3, 3]
-    common = dict(camera_position=CAMERA_POSITION, autoplay=False)
+    common = {"camera_position": CAMERA_POSITION, "autoplay": False}
     full = export_html(
-        arm, q, t, folder / "scene.html", path=tip + [[0, 0, 0], [0.05, 0, 0]],
+        arm, q, t, folder / "scene.html", path=tip + np.array([[0, 0, 0], [0.05, 0, 0]]),
         motion=["line", "line"], obstacles=[ball, wall],
         plane=tilted_plane([0.0, 0.2, -0.08]), **common,
     )  # fmt: skip
@@ -76,7 +76,8 @@ def test_obstacles_are_drawn_where_they_are(screenshots):
     assert full.shape == (HEIGHT, WIDTH, 3)
     for obstacle in (ball, wall):
         where = _project(obstacle.centre)
-        assert 0 <= where[0] < WIDTH and 0 <= where[1] < HEIGHT
+        assert 0 <= where[0] < WIDTH
+        assert 0 <= where[1] < HEIGHT
         assert _window(_orange(full), where, 12).mean() > 0.5, obstacle.name
         assert not _window(_orange(bare), where, 12).any(), obstacle.name
     # Nothing orange far from the obstacles (e.g. the top-left corner).

@@ -1,0 +1,26 @@
+"""Validation of row-vector inputs shared by the domain packages (numba-free, light to import)."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from lynxplan.exceptions import NonFiniteInputError, ShapeError
+
+
+def as_rows(values: Any, width: int, name: str) -> np.ndarray:
+    """Validate one row, shape (width,), or a batch, shape (N, width), of finite numbers.
+
+    Returns:
+        A C-contiguous float array of shape (N, width) (N = 1 for one row).
+
+    Raises:
+        ShapeError: another shape. NonFiniteInputError: NaN or infinity.
+    """
+    array = np.asarray(values, dtype=float)
+    if array.ndim not in (1, 2) or array.shape[-1] != width:
+        raise ShapeError(name, f"({width},) or (N, {width})", array.shape)
+    if not np.isfinite(array).all():
+        raise NonFiniteInputError(name)
+    return np.ascontiguousarray(array.reshape(-1, width))

@@ -1,0 +1,62 @@
+"""Every package lynxplan/ imports is declared in pyproject.toml; one version string."""
+
+from __future__ import annotations
+
+import ast
+import re
+import sys
+from importlib.metadata import packages_distributions, version
+from pathlib import Path
+
+import pytest
+
+import lynxplan
+
+tomllib = pytest.importorskip("tomllib")  # Python >= 3.11
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _imported_top_level_modules() -> set[str]:
+    names: set[str] = set()
+    for path in (ROOT / "lynxplan").rglob("*.py"):
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
+            if isinstance(node, ast.Import):
+                names.update(alias.name.split(".")[0] for alias in node.names)
+            elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+                names.add(node.module.split(".")[0])
+    return names - set(sys.stdlib_module_names) - {"lynxplan", "__future__"}
+
+
+def _normalise(name: str) -> str:
+    return re.sub(r"[-_.]+", "-", name).lower()
+
+
+def _declared() -> set[str]:
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    requirements = list(project["dependencies"])
+    for extra in project["optional-dependencies"].values():
+        requirements += extra
+    return {_normalise(re.split(r"[<>=!~\[; ]", r, maxsplit=1)[0]) for r in requirements}
+
+
+#: Modules whose distribution the metadata does not map (cmeel wheels install under a prefix).
+KNOWN = {"pinocchio": ["pin"]}
+
+
+def test_every_imported_package_is_declared() -> None:
+    distributions = {**packages_distributions(), **KNOWN}
+    declared = _declared()
+    # pytest: only the pytest plugin entry point imports it, and pytest is what loads it.
+    missing = {
+        module: distributions.get(module, ["?"])
+        for module in _imported_top_level_modules() - {"pytest"}
+        if not declared & {_normalise(d) for d in distributions.get(module, [module])}
+    }
+    assert not missing, f"imported but not declared in pyproject.toml: {missing}"
+
+
+def test_version_comes_from_the_package_metadata() -> None:
+    assert lynxplan.__version__ == version("lynxplan")
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))
+    assert pyproject["project"]["version"] == lynxplan.__version__
