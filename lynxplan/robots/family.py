@@ -95,7 +95,7 @@ def _angle_from_parallel(u: np.ndarray, v: np.ndarray) -> float:
     return float(math.asin(min(1.0, float(np.linalg.norm(np.cross(u, v))))))
 
 
-def recognise_family(
+def recognise_family(  # noqa: PLR0915 (one pass over the zero configuration, kept in reading order)
     model: Any, tool_frame_id: int, lower: np.ndarray, upper: np.ndarray, limit_tolerance: float
 ) -> tuple[FamilyParameters | None, str]:
     """The canonical parameters if the chain is yaw-pitch^3-roll, else ``(None, reason)``."""

@@ -166,7 +166,7 @@ def _lock_joints(xml: str, angles: dict[str, float]) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
-def load_model(
+def load_model(  # noqa: PLR0912, PLR0915 (URDF reading steps in order)
     name_or_urdf: str | Path,
     tool: str | None,
     base: np.ndarray | None,

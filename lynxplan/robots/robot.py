@@ -63,7 +63,7 @@ def _as_array(x: Any, name: str, shape_tail: tuple[int, ...]) -> np.ndarray:
     return array.reshape((-1, *shape_tail))
 
 
-def make_target(
+def make_target(  # noqa: PLR0912 (one branch per target form)
     poses: Any = None,
     positions: Any = None,
     approaches: Any = None,

@@ -52,7 +52,8 @@ def test_full_pose_branches_are_complete(name: str) -> None:
         exact = [s.q for s in result.solutions if s.within_limits and s.orientation_error < 1e-9]
         for q in _dense_search(robot, pose, approach_only=False):
             gaps = [np.abs(q - b).max() for b in exact]
-            assert gaps and min(gaps) < 1e-6, (q0, q)
+            assert gaps, (q0, q)
+            assert min(gaps) < 1e-6, (q0, q)
             found_total += 1
     assert found_total > TARGETS * 10  # the search did converge, many times
 
@@ -71,7 +72,8 @@ def test_approach_branches_are_complete_off_axis_tool(tmp_path: Path) -> None:
         path = tmp_path / f"arm{k}.urdf"
         path.write_text(random_family_urdf(rng, off_axis_tool=True, approach_is_z=True))
         robot = load_robot(path, tool="tool")
-        assert robot.family is not None and not robot.family.tool_on_roll_axis
+        assert robot.family is not None
+        assert not robot.family.tool_on_roll_axis
         np.testing.assert_allclose(robot.approach_in_tool, [0, 0, 1], atol=1e-12)
         for q0 in robot.random_configurations(TARGETS // 2, seed=23):
             pose = robot.fk(q0)
@@ -81,6 +83,7 @@ def test_approach_branches_are_complete_off_axis_tool(tmp_path: Path) -> None:
             ]
             for q in _dense_search(robot, pose, approach_only=True):
                 gaps = [np.abs(q - b).max() for b in exact]
-                assert gaps and min(gaps) < 1e-6, (q0, q)
+                assert gaps, (q0, q)
+                assert min(gaps) < 1e-6, (q0, q)
                 checked += 1
     assert checked > 50

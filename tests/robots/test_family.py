@@ -101,7 +101,8 @@ def test_convention_flipped_axes_and_shifted_zeros(tmp_path: Path) -> None:
     signs = np.array([-1, 1, -1, -1, -1])
     zeros = np.array([0.4, 0.3, -0.2, 0.5, 0.7])
     other = load_robot(_write(tmp_path / "b.urdf", tuple(signs), tuple(zeros)), tool="tool")
-    assert base.family is not None and other.family is not None
+    assert base.family is not None
+    assert other.family is not None
     assert other.family.signs != base.family.signs
     q = np.random.default_rng(0).uniform(-2, 2, size=(200, 5))
     q_other = signs * (q - zeros)
@@ -122,7 +123,8 @@ def test_unreachable_target_gives_nearest_solution() -> None:
     far = np.eye(4)
     far[:3, 3] = [2.0, 0.3, 0.1]
     batch = robot.ik_batch(np.stack([far, robot.fk(np.zeros(5))]))
-    assert not batch.reachable[0] and batch.reachable[1]
+    assert not batch.reachable[0]
+    assert batch.reachable[1]
     reach = np.linalg.norm(robot.workspace(20_000)[:, :2] - 0.0, axis=1).max()
     assert batch.distance[0] > 2.0 - 0.5  # arm reach is below 0.5 m
     single = robot.ik(far)
@@ -148,7 +150,8 @@ def test_track_is_continuous_and_flags_jumps() -> None:
     back = q0.copy()
     back[0] += np.pi - 0.2
     flipped = robot.ik_track(robot.fk(path), np.clip(back, *robot.limits.position.T))
-    assert flipped.jumps and flipped.jumps[0].index == 0
+    assert flipped.jumps
+    assert flipped.jumps[0].index == 0
     assert flipped.jumps[0].size > 0.5
 
 
@@ -186,7 +189,8 @@ def test_so101_info_and_locked_jaw() -> None:
 
 def test_so100_tool_between_the_jaws() -> None:
     robot = load_robot("so100")
-    assert robot.family is not None and robot.family.tool_on_roll_axis
+    assert robot.family is not None
+    assert robot.family.tool_on_roll_axis
     # the tool is 0.1014 m along the roll axis from the wrist_roll joint
     import pinocchio as pin
 

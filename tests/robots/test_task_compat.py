@@ -19,7 +19,8 @@ def test_approach_only_pose_and_reference(name: str) -> None:
     target[:3, :2] = 0.0  # ignored
     result = robot.ik(target, q_reference=q, approach_only=True)
     np.testing.assert_allclose(result.q, q, atol=1e-9)
-    assert robot.limits.position.shape == (5, 2) and robot.limits.velocity.shape == (5,)
+    assert robot.limits.position.shape == (5, 2)
+    assert robot.limits.velocity.shape == (5,)
     assert robot.urdf_path.is_file()
     with pytest.raises(TargetError, match="select must be 'nearest'"):
         robot.ik(pose, select="report")

@@ -42,7 +42,7 @@ def random_family_urdf(
         "j1",
         "l0",
         "l1",
-        rng.uniform(-0.03, 0.03, 3) + [0, 0, 0.05],
+        rng.uniform(-0.03, 0.03, 3) + np.array([0, 0, 0.05]),
         (0.0, 0.0, rng.uniform(-math.pi, math.pi)),
         (0, 0, sign()),
         -2.5,

@@ -339,7 +339,7 @@ def _keep_root(
 
 
 @numba.njit(cache=True, nogil=True)
-def _roll_candidates(
+def _roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
     prm: np.ndarray,
     target: np.ndarray,
     g: np.ndarray,
@@ -749,7 +749,7 @@ def _orientation_error(
 
 
 @numba.njit(cache=True, nogil=True)
-def family_ik_kernel(
+def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per pose)
     prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,

@@ -81,7 +81,7 @@ def _angle(pose: np.ndarray, target: np.ndarray, approach_only: bool, u: np.ndar
 
 
 @numba.njit(cache=True, nogil=True)
-def numerical_ik_kernel(
+def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per pose)
     placements: np.ndarray,
     axes: np.ndarray,
     targets: np.ndarray,
