@@ -858,6 +858,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         prm, target, g, mode, pitch[n], roots[ri], side, elbow, phi_ref, sum_ref, q
                     )
                     polished = False
+                    hold = False
                     if need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
                         # a tentative root: a branch only if Newton converges on the exact model
                         if (
@@ -877,8 +878,28 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                             )
                             >= _NEWTON_TOLERANCE
                         ):
-                            continue
-                        polished = True
+                            firm = 0
+                            for j in range(count):
+                                firm += roots[MAX_ROOTS + j] == 0.0
+                            if firm > 0:
+                                continue
+                            # only tentative roots on this side: keep the nearest, roll held
+                            miss = _branch(
+                                prm,
+                                target,
+                                g,
+                                mode,
+                                pitch[n],
+                                roots[ri],
+                                side,
+                                elbow,
+                                phi_ref,
+                                sum_ref,
+                                q,
+                            )
+                            hold = True
+                        else:
+                            polished = True
                     elif not exact and not rooted:
                         trial[:] = q
                         if (
@@ -920,6 +941,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                             mode == MODE_PITCH
                             or (mode == MODE_APPROACH and not off_axis)
                             or not rooted
+                            or hold
                         ):
                             rg = q[4]
                         _polish(
