@@ -16,13 +16,18 @@ import os
 import re
 import sys
 import traceback
+import warnings
 from collections.abc import Sequence
 from typing import Any
 
-from lynxplan import __version__
-from lynxplan.exceptions import LynxplanError
+from lynxplan import __version__, guards
+from lynxplan.exceptions import LynxplanError, LynxplanInputError
 
-_NEGATIVE_NUMBER = re.compile(r"^-(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+#: Negative numbers, including ``-inf`` and ``-nan`` (which the value checks then reject with a
+#: message naming the option, instead of argparse taking them for unknown options).
+_NEGATIVE_NUMBER = re.compile(
+    r"^-((\d+\.?\d*|\.\d+)([eE][-+]?\d+)?|inf|infinity|nan)$", re.IGNORECASE
+)
 
 #: Success.
 EXIT_OK = 0
@@ -83,6 +88,12 @@ def build_parser() -> argparse.ArgumentParser:
     )
     parser.add_argument("--version", action="version", version=f"lynxplan {__version__}")
     parser.add_argument(
+        "--max-samples",
+        metavar="N",
+        help="raise the resource limit on samples, grid cells and batch sizes (default "
+        "100,000,000; accepted anywhere on the command line)",
+    )
+    parser.add_argument(
         "--debug",
         action="store_true",
         help="show the full traceback of an error (accepted anywhere on the command line)",
@@ -99,12 +110,37 @@ def _one_line(message: str) -> str:
     return " ".join(str(message).split())
 
 
-def _split_debug(argv: Sequence[str]) -> tuple[list[str], bool]:
-    """Remove ``--debug`` from anywhere before a ``--`` separator."""
+def _split_global(argv: Sequence[str]) -> tuple[list[str], bool, str | None]:
+    """Remove the global options ``--debug`` and ``--max-samples N`` (or ``=N``) from anywhere
+    before a ``--`` separator; returns the rest, debug, and the max-samples text (or None)."""
     args = list(argv)
     end = args.index("--") if "--" in args else len(args)
-    debug = "--debug" in args[:end]
-    return [a for i, a in enumerate(args) if not (i < end and a == "--debug")], debug
+    rest: list[str] = []
+    debug, max_samples = False, None
+    i = 0
+    while i < len(args):
+        arg = args[i]
+        if i < end and arg == "--debug":
+            debug = True
+        elif i < end and arg.startswith("--max-samples="):
+            max_samples = arg.split("=", 1)[1]
+        elif i < end and arg == "--max-samples":
+            if i + 1 >= end:
+                raise LynxplanInputError("--max-samples: expected a number N")
+            max_samples = args[i + 1]
+            i += 1
+        else:
+            rest.append(arg)
+        i += 1
+    return rest, debug, max_samples
+
+
+def _max_samples(text: str) -> int:
+    try:
+        value = float(text.replace("_", ""))
+    except ValueError:
+        raise LynxplanInputError(f"--max-samples: {text!r} is not a number") from None
+    return guards.count("--max-samples", value, minimum=1, limit=None)
 
 
 def _report(message: str, debug: bool) -> None:
@@ -119,13 +155,19 @@ def main(argv: Sequence[str] | None = None) -> int:
     Never raises (except SystemExit from ``--help``/``--version`` handled here too) and never
     lets a traceback reach the user unless ``--debug`` is given.
     """
-    args_list, debug = _split_debug(sys.argv[1:] if argv is None else argv)
+    argv = sys.argv[1:] if argv is None else argv
+    debug = "--debug" in argv
     try:
+        args_list, debug, max_samples = _split_global(argv)
         try:
             args = build_parser().parse_args(args_list)
         except SystemExit as exc:  # --help, --version, usage errors (already printed)
             return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
-        code: int = args.handler(args)
+        limit = None if max_samples is None else _max_samples(max_samples)
+        with guards.raised_limits(max_samples=limit), warnings.catch_warnings():
+            if not debug:  # library warnings (numpy, Pinocchio) would break the one-line rule
+                warnings.simplefilter("ignore")
+            code: int = args.handler(args)
         return code
     except LynxplanError as exc:
         _report(f"error: {_one_line(str(exc))}", debug)

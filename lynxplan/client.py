@@ -71,6 +71,28 @@ class RunResult:
     artifacts: tuple[str, ...]
     timings: Mapping[str, float]
 
+    @property
+    def result(self) -> Any:
+        """The library's :class:`lynxplan.scenarios.Result`, rebuilt from the run's report
+        (None until the run succeeded)."""
+        from lynxplan.scenarios.base import ExpectationResult, Result
+
+        if self.state != "succeeded" or not isinstance(self.report, Mapping):
+            return None
+        r = self.report
+        return Result(
+            kind=r["kind"],
+            schema_version=r["schema_version"],
+            name=r["name"],
+            inputs=r["inputs"],
+            metrics=r["metrics"],
+            expectations=tuple(ExpectationResult(**e) for e in r["expectations"]),
+            artifacts=tuple(r["artifacts"]),
+            timing=r["timing"],
+            details=r["details"],
+            summary=self.summary or "",
+        )
+
 
 class Client:
     """HTTP client of a lynxplan server.
@@ -122,15 +144,19 @@ class Client:
         return orjson.loads(self._request(method, path, **kwargs).content)
 
     def _binary(self, path: str, array: np.ndarray, params: dict[str, Any]) -> dict[str, Any]:
-        from lynxplan.service.wire import read_npz
+        from lynxplan.service.wire import read_arrays
 
         response = self._request(
             "POST", path, content=np.ascontiguousarray(array, dtype="<f8").tobytes(),
             params=params, headers={"Content-Type": "application/octet-stream",
                                     "X-Shape": ",".join(map(str, array.shape)),
-                                    "Accept": "application/x-npz"},
+                                    "Accept": "application/x-npy-stream"},
         )  # fmt: skip
-        arrays: dict[str, Any] = read_npz(response.content)
+        arrays: dict[str, Any] = read_arrays(
+            response.content,
+            response.headers.get("content-type", ""),
+            response.headers.get("X-Arrays", ""),
+        )
         arrays.update(orjson.loads(response.headers.get("X-Result", "{}")))
         return arrays
 
@@ -267,6 +293,57 @@ class Client:
             for s in answer["segments"]
         ]
 
+    def plan(
+        self,
+        start: Any,
+        goal: Any,
+        obstacles: Sequence[Any] = (),
+        *,
+        seed: int = 0,
+        time_limit: float = 1.0,
+        options: Mapping[str, Any] | None = None,
+        robot: str = "al5",
+    ) -> Any:
+        """Plan on the server, as :func:`lynxplan.planning.plan`: start (5,) [rad], goal (5,)
+        joints or (4, 4) pose [m]; the library's
+        :class:`~lynxplan.planning.PlannedTrajectory`."""
+        from lynxplan.collision import ClearanceRecord
+        from lynxplan.planning import PlannedTrajectory, PlannerOptions, PlanningStats
+        from lynxplan.planning.verify import VerificationReport
+
+        body = {
+            "robot": robot,
+            "start": np.asarray(start, dtype=float),
+            "goal": np.asarray(goal, dtype=float),
+            "obstacles": [_obstacle_json(o) for o in obstacles],
+            "seed": seed,
+            "time_limit": time_limit,
+            "options": dict(options) if options else None,
+        }
+        a = self._json("POST", "/plan", body)
+        v = dict(a["verification"])
+        v["min_clearance"] = ClearanceRecord(
+            **{k: _number(x) for k, x in v["min_clearance"].items()}
+        )
+        option_fields: dict[str, Any] = {
+            k: tuple(x) if isinstance(x, list) else x for k, x in a["options"].items()
+        }
+        return PlannedTrajectory(
+            waypoints=_read_only(np.array(a["waypoints"], dtype=float)),
+            t=_read_only(np.array(a["t"], dtype=float)),
+            q=_read_only(np.array(a["q"], dtype=float)),
+            qd=_read_only(np.array(a["qd"], dtype=float)),
+            qdd=_read_only(np.array(a["qdd"], dtype=float)),
+            segment=_read_only(np.array(a["segment"], dtype=np.asarray(0).dtype)),
+            verification=VerificationReport(**v),
+            goal_label=a["goal_label"],
+            goal_index=a["goal_index"],
+            path_length=a["path_length"],
+            seed=a["seed"],
+            stats=PlanningStats(**a["stats"]),
+            options=PlannerOptions(**option_fields),
+        )  # fmt: skip
+
     # -- runs ----------------------------------------
     def submit(self, scenario: str | Path | Mapping[str, Any], *, quick: bool = False) -> str:
         """Submit a scenario (file path, YAML text or mapping); the run id."""
@@ -288,9 +365,10 @@ class Client:
         )
         return str(answer["id"])
 
-    def status(self, run_id: str) -> RunResult:
-        """The run's current record."""
-        fields = self._json("GET", f"/runs/{run_id}")
+    def status(self, run_id: str, wait: float = 0.0) -> RunResult:
+        """The run's current record; with ``wait`` [s], the server holds the answer until the
+        run ends or that time passed (long poll)."""
+        fields = self._json("GET", f"/runs/{run_id}", params={"wait": wait} if wait else None)
         return RunResult(
             fields["id"],
             fields["state"],
@@ -302,13 +380,12 @@ class Client:
             fields["timings"],
         )
 
-    def wait(self, run_id: str, timeout: float = 3600.0, poll: float = 0.05) -> RunResult:
-        """Poll until the run ends (``timeout`` in [s])."""
+    def wait(self, run_id: str, timeout: float = 3600.0) -> RunResult:
+        """Wait until the run ends (``timeout`` in [s]), by long polls of at most 10 s."""
         deadline = time.monotonic() + timeout
-        while (result := self.status(run_id)).state not in _FINAL:
+        while (result := self.status(run_id, wait=min(10.0, timeout))).state not in _FINAL:
             if time.monotonic() > deadline:
                 raise ServiceError(0, f"run {run_id} did not end within {timeout:g} s")
-            time.sleep(poll)
         return result
 
     def cancel(self, run_id: str) -> RunResult:
@@ -411,9 +488,14 @@ def run_remote(url: str, scenario: str | Path, out_dir: str | Path, *, quick: bo
     if result.state != "succeeded":
         raise LynxplanError(f"scenario {scenario}: run {result.id} {result.state}: {result.error}")
     print(result.summary)
+    library = result.result
+    if library is not None and library.expectations:
+        held = sum(e.passed for e in library.expectations)
+        print(f"expectations: {held} of {len(library.expectations)} hold")
+    print(f"outputs in {out_dir}/: {', '.join(result.artifacts)}")
     if not result.ok:
         print("failed expectations:")
-        for failure in (result.error or "").split("; "):
+        for failure in library.failed_expectations if library is not None else ():
             print(f"  - {failure}")
         return 1
     return 0

@@ -13,8 +13,59 @@ class LynxplanError(Exception):
     """Base class of every error raised by lynxplan on purpose."""
 
 
-class InputError(LynxplanError, ValueError):
+class LynxplanInputError(LynxplanError, ValueError):
+    """Bad input: a value, array, file or option lynxplan refuses (the CLI exits 2).
+
+    Every error caused by what the user gave (as opposed to a problem without a solution, such
+    as an unreachable pose) is a subclass of this one.
+    """
+
+
+class InputError(LynxplanInputError):
     """An argument has the wrong shape, type, value or unit."""
+
+
+class OutOfRangeError(InputError):
+    """A value lies outside the documented valid range of its quantity (see lynxplan.guards).
+
+    Attributes:
+        name: Name of the value (argument, option or scenario key).
+        value: The value given.
+        requirement: The valid range, e.g. ``"finite, |q| <= 100 rad"``.
+    """
+
+    def __init__(self, name: str, value: object, requirement: str) -> None:
+        self.name = name
+        self.value = value
+        self.requirement = requirement
+        super().__init__(f"{name} = {_short(value)} is out of range: must be {requirement}")
+
+
+class ResourceLimitError(InputError):
+    """A request would exceed a resource limit (memory or time) and is refused before it starts.
+
+    Attributes:
+        quantity: What is counted, e.g. ``"workspace grid cells"``.
+        requested: The size the input implies.
+        limit: The largest size allowed.
+        how_to_raise: How the user can raise the limit (an option or a scenario ``limits:`` key).
+    """
+
+    def __init__(self, quantity: str, requested: float, limit: float, how_to_raise: str) -> None:
+        self.quantity = quantity
+        self.requested = requested
+        self.limit = limit
+        self.how_to_raise = how_to_raise
+        super().__init__(
+            f"{quantity}: {requested:.4g} requested, more than the limit of {limit:.4g}; "
+            f"{how_to_raise}"
+        )
+
+
+def _short(value: object, width: int = 60) -> str:
+    """``repr`` of a value cut to ``width`` characters, for one-line messages."""
+    text = f"{value:.6g}" if isinstance(value, float) else repr(value)
+    return text if len(text) <= width else text[: width - 3] + "..."
 
 
 class ShapeError(InputError):
@@ -40,9 +91,10 @@ class NonFiniteInputError(InputError):
         name: Name of the argument.
     """
 
-    def __init__(self, name: str) -> None:
+    def __init__(self, name: str, detail: str = "") -> None:
         self.name = name
-        super().__init__(f"{name} contains NaN or infinite values")
+        extra = f" ({detail})" if detail else ""
+        super().__init__(f"{name} contains NaN or infinite values{extra}")
 
 
 class UnknownUnitError(InputError):
@@ -121,7 +173,7 @@ class NoSolutionWithinLimitsError(KinematicsError):
     """IK found solutions, but none within the joint limits."""
 
 
-class ScenarioError(LynxplanError):
+class ScenarioError(LynxplanInputError):
     """A scenario file is missing, unreadable or invalid.
 
     Attributes:
@@ -189,7 +241,7 @@ class PathNotFollowableError(KinematicsError):
         )
 
 
-class ModelError(LynxplanError):
+class ModelError(LynxplanInputError):
     """A robot model (URDF) cannot be loaded or does not have the expected structure."""
 
 
@@ -378,14 +430,15 @@ class PlanningFailed(PlanningError):  # noqa: N818 (the name the issue gives)
         nodes: Number of tree nodes created (both trees).
         iterations: Number of sampling iterations.
         elapsed: Planning time spent, in [s].
-        reason: ``"time limit"`` or ``"node limit"`` (with the budget).
+        reason: Why the search stopped: ``"time limit 1 s reached"``, ``"node limit 20000
+            reached"``, or a start/goal the conservative checker cannot certify.
     """
 
     def __init__(self, nodes: int, iterations: int, elapsed: float, reason: str) -> None:
         self.nodes, self.iterations, self.elapsed, self.reason = nodes, iterations, elapsed, reason
         super().__init__(
-            f"no collision-free path found: {reason} reached after {nodes} nodes "
-            f"({iterations} iterations, {elapsed * 1e3:.1f} ms)"
+            f"no collision-free path found after {nodes} nodes "
+            f"({iterations} iterations, {elapsed * 1e3:.1f} ms): {reason}"
         )
 
 

@@ -20,11 +20,14 @@ ROOT = Path(__file__).resolve().parents[1]
 def _imported_top_level_modules() -> set[str]:
     names: set[str] = set()
     for path in (ROOT / "lynxplan").rglob("*.py"):
+        found: set[str] = set()
         for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
             if isinstance(node, ast.Import):
-                names.update(alias.name.split(".")[0] for alias in node.names)
+                found.update(alias.name.split(".")[0] for alias in node.names)
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
-                names.add(node.module.split(".")[0])
+                found.add(node.module.split(".")[0])
+        # Peer scripts run as plain scripts in their own venvs and import their siblings.
+        names |= found - {sibling.stem for sibling in path.parent.glob("*.py")}
     return names - set(sys.stdlib_module_names) - {"lynxplan", "__future__"}
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 import pytest
 
 PACKAGE = Path(__file__).resolve().parents[1] / "lynxplan"
-DOMAIN = ["arm", "trajectory", "collision", "parallel", "singularity"]
+DOMAIN = ["arm", "trajectory", "collision", "parallel", "singularity", "planning"]
 FORBIDDEN_IN_DOMAIN = (
     "pydantic",
     "yaml",

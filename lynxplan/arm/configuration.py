@@ -11,4 +11,6 @@ def as_configurations(
     q: np.ndarray | list[float] | tuple[float, ...], name: str = "q"
 ) -> np.ndarray:
     """Validate joint angles: shape (5,) or (N, 5), finite. Returns a float (N, 5) array."""
-    return as_rows(q, 5, name)
+    from lynxplan.guards import float_array  # strings, ragged lists: InputError, not ValueError
+
+    return as_rows(float_array(name, q), 5, name)

@@ -75,7 +75,9 @@ _DEFAULT_LIMITS = JointLimits()
 
 def as_poses(T: np.ndarray, name: str = "T") -> np.ndarray:
     """Validate poses: shape (4, 4) or (N, 4, 4). Returns a contiguous float (N, 4, 4) array."""
-    array = np.asarray(T, dtype=float)
+    from lynxplan.guards import float_array  # strings, ragged lists: InputError, not ValueError
+
+    array = float_array(name, T)
     if array.ndim not in (2, 3) or array.shape[-2:] != (4, 4):
         raise ShapeError(name, "(4, 4) or (N, 4, 4)", array.shape)
     return np.ascontiguousarray(array.reshape(-1, 4, 4))
@@ -84,14 +86,14 @@ def as_poses(T: np.ndarray, name: str = "T") -> np.ndarray:
 def _as_reference(q_reference: np.ndarray | None, n: int) -> np.ndarray:
     if q_reference is None:
         return np.zeros((1, 5))
-    ref = np.asarray(q_reference, dtype=float)
-    if ref.shape == (5,):
-        return ref.reshape(1, 5)
-    if ref.shape != (n, 5):
+    from lynxplan.guards import float_array
+
+    ref = float_array("q_reference", q_reference)
+    if ref.shape not in ((5,), (n, 5)):
         raise ShapeError("q_reference", f"(5,) or ({n}, 5)", ref.shape)
-    if not np.isfinite(ref).all():
+    if not np.isfinite(ref).all():  # also for one (5,) reference
         raise NonFiniteInputError("q_reference")
-    return np.ascontiguousarray(ref)
+    return np.ascontiguousarray(ref.reshape(-1, 5))
 
 
 def solve_ik_batch(

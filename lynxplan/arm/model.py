@@ -8,6 +8,11 @@ of the same structure with other dimensions works through the same closed forms.
 from __future__ import annotations
 
 import math
+import os
+import sys
+import tempfile
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from functools import cached_property
 from importlib import resources
@@ -16,6 +21,7 @@ from typing import TYPE_CHECKING, Any, Literal, NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.arm.configuration import as_configurations
 from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
 from lynxplan.constants import (
@@ -24,6 +30,7 @@ from lynxplan.constants import (
     STRICT_ORIENTATION_TOLERANCE,
 )
 from lynxplan.exceptions import (
+    InputError,
     ModelError,
     NonFiniteInputError,
     NoSolutionWithinLimitsError,
@@ -136,10 +143,13 @@ class Arm:
         self.urdf_path = Path(urdf_path) if urdf_path is not None else default_urdf_path()
         if not self.urdf_path.is_file():
             raise ModelError(f"URDF file not found: {self.urdf_path}")
-        try:
-            self.model = pin.buildModelFromUrdf(str(self.urdf_path))
-        except (RuntimeError, ValueError) as exc:
-            raise ModelError(f"cannot load URDF {self.urdf_path}: {exc}") from exc
+        with native_stderr_captured() as noise:
+            try:
+                self.model = pin.buildModelFromUrdf(str(self.urdf_path))
+            except (RuntimeError, ValueError) as exc:
+                detail = " ".join(noise().split())[:200]
+                extra = f" (parser: {detail})" if detail else ""
+                raise ModelError(f"cannot load URDF {self.urdf_path}: {exc}{extra}") from exc
         self.data = self.model.createData()
         self.geometry = _read_geometry(self.model)
         self.limits = _read_limits(self.model)
@@ -168,16 +178,25 @@ class Arm:
 
     # -- kinematics -------------------------------------------------------------------------------
     def fk(self, q: np.ndarray) -> np.ndarray:
-        """Tool pose (closed form). q: shape (5,) or (N, 5) in [rad] -> (4, 4) or (N, 4, 4), [m]."""
+        """Tool pose (closed form). q: shape (5,) or (N, 5) in [rad] -> (4, 4) or (N, 4, 4), [m].
+
+        Raises:
+            LynxplanInputError: q of another shape or dtype, NaN/Inf, |q| > 100 rad, a batch
+                beyond the resource limit (see :mod:`lynxplan.guards`).
+        """
         from lynxplan.arm.kinematics import forward_kinematics
 
-        return forward_kinematics(q, self.geometry)
+        return forward_kinematics(guards.configurations("q", q), self.geometry)
 
     def jacobian(self, q: np.ndarray) -> np.ndarray:
-        """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5)."""
+        """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED: (5,) or (N, 5) -> (6, 5) or (N, 6, 5).
+
+        Raises:
+            LynxplanInputError: as :meth:`fk`.
+        """
         from lynxplan.arm.kinematics import tool_jacobian
 
-        return tool_jacobian(q, self.geometry)
+        return tool_jacobian(guards.configurations("q", q), self.geometry)
 
     def frame_placement(self, q: np.ndarray, frame: str = TOOL_FRAME) -> np.ndarray:
         """Pose of a URDF frame from Pinocchio. q: shape (5,) in [rad] -> (4, 4) in [m].
@@ -186,7 +205,7 @@ class Arm:
         """
         import pinocchio as pin
 
-        config = as_configurations(q)[0]
+        config = as_configurations(guards.configurations("q", q))[0]
         frame_id = self._frame_id(frame)
         pin.forwardKinematics(self.model, self.data, config)
         return np.array(pin.updateFramePlacement(self.model, self.data, frame_id).homogeneous)
@@ -195,7 +214,7 @@ class Arm:
         """Pinocchio frame Jacobian, LOCAL_WORLD_ALIGNED. q: (5,) in [rad] -> (6, 5)."""
         import pinocchio as pin
 
-        config = as_configurations(q)[0]
+        config = as_configurations(guards.configurations("q", q))[0]
         return np.array(
             pin.computeFrameJacobian(
                 self.model,
@@ -221,14 +240,24 @@ class Arm:
         approach_only: bool = False,
         limit_tolerance: float = LIMIT_SNAP_TOLERANCE,
     ) -> IkBatch:
-        """All-branch IK of many poses; see :func:`lynxplan.arm.ik.solve_ik_batch`."""
+        """All-branch IK of many poses; see :func:`lynxplan.arm.ik.solve_ik_batch`.
+
+        Raises:
+            LynxplanInputError: T not of shape (4, 4) or (N, 4, 4) real numbers, NaN/Inf,
+                translations beyond 1 km, a bottom row other than 0 0 0 1, rotation blocks that
+                are reflections or not orthonormal (within 1e-3), q_reference out of range,
+                a batch beyond the resource limit (see :mod:`lynxplan.guards`).
+        """
+        poses = guards.poses("T", T, approach_only=approach_only)
+        if q_reference is not None:
+            q_reference = guards.angles("q_reference", q_reference)
         return _ik().solve_ik_batch(  # type: ignore[no-any-return]
-            T,
+            poses,
             geometry=self.geometry,
             limits=self.limits,
             q_reference=q_reference,
             approach_only=approach_only,
-            limit_tolerance=limit_tolerance,
+            limit_tolerance=guards.tolerance("limit_tolerance", limit_tolerance, "rad"),
         )
 
     def ik(
@@ -256,23 +285,25 @@ class Arm:
             limit_tolerance: Angles this far outside a limit, in [rad], are snapped onto it.
 
         Raises:
-            ShapeError, NonFiniteInputError, NotRigidTransformError: bad input.
+            LynxplanInputError (ShapeError, NonFiniteInputError, NotRigidTransformError,
+                OutOfRangeError): bad input, see :mod:`lynxplan.guards`.
             UnreachablePoseError: the wrist centre is out of reach (carries the distance).
             OrientationNotReachableError: strict mode and a residual above the tolerance.
         """
-        pose = np.asarray(T, dtype=float)
-        if pose.shape != (4, 4):
-            raise ShapeError("T", "(4, 4)", pose.shape)
+        pose = guards.poses("T", T, batch=False, approach_only=approach_only)
         if select not in ("nearest", "report"):
-            raise ValueError(f"select must be 'nearest' or 'report'. Got: {select!r}")
+            raise InputError(f"select must be 'nearest' or 'report'. Got: {select!r:.60}")
+        orientation_tolerance = guards.tolerance(
+            "orientation_tolerance", orientation_tolerance, "rad"
+        )
+        limit_tolerance = guards.tolerance("limit_tolerance", limit_tolerance, "rad")
         if q_reference is None:
             reference = _ZEROS
         else:
-            reference = np.asarray(q_reference, dtype=float)
+            reference = guards.float_array("q_reference", q_reference)
             if reference.shape != (5,):
                 raise ShapeError("q_reference", "(5,)", reference.shape)
-            if not np.isfinite(reference).all():
-                raise NonFiniteInputError("q_reference")
+            reference = guards.angles("q_reference", reference)
         rows, scalars = np.empty((4, 8)), np.empty(5)
         flags = (1 if approach_only else 0) | (2 if select == "report" else 0)
         params = self._ik_params
@@ -312,9 +343,45 @@ def _raise_for_status(status: int, miss: float, deviation: float) -> None:
         raise UnreachablePoseError(miss)
 
 
+@contextmanager
+def native_stderr_captured() -> Iterator[Callable[[], str]]:
+    """Capture what native code (urdfdom, Pinocchio) writes to file descriptor 2 in the block.
+
+    Yields a function returning the captured text, so that a parser's own messages become part
+    of one clear error instead of noise on the user's terminal.
+    """
+    try:
+        saved = os.dup(2)
+    except OSError:  # no usable stderr descriptor (embedded interpreter): capture nothing
+        yield lambda: ""
+        return
+    with tempfile.TemporaryFile() as sink:
+
+        def captured() -> str:
+            return os.pread(sink.fileno(), 4096, 0).decode("utf-8", "replace")
+
+        sys.stderr.flush()
+        os.dup2(sink.fileno(), 2)
+        try:
+            yield captured
+        finally:
+            os.dup2(saved, 2)
+            os.close(saved)
+
+
 def _read_limits(model: Any) -> JointLimits:
     position = np.column_stack((model.lowerPositionLimit, model.upperPositionLimit))
     velocity = np.array(model.velocityLimit, dtype=float)
+    names = tuple(model.names)[1:]
+    for j, name in enumerate(names[: len(velocity)]):
+        lower, upper = float(position[j, 0]), float(position[j, 1])
+        if not (math.isfinite(lower) and math.isfinite(upper) and lower < upper):
+            raise ModelError(
+                f"joint {name}: position limits [{lower:g}, {upper:g}] rad must be finite with "
+                "lower < upper"
+            )
+        if not (math.isfinite(velocity[j]) and velocity[j] > 0):
+            raise ModelError(f"joint {name}: velocity limit {velocity[j]:g} rad/s must be > 0")
     position.setflags(write=False)
     velocity.setflags(write=False)
     return JointLimits(position=position, velocity=velocity)

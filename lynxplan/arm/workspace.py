@@ -18,7 +18,7 @@ import numba
 import numpy as np
 
 from lynxplan.arm.geometry import ArmGeometry, JointLimits
-from lynxplan.exceptions import InputError
+from lynxplan.exceptions import InputError, OutOfRangeError
 
 #: Report sampling steps, in [rad]: q1 by pi/60, q2..q4 by pi/15.
 REPORT_STEP_Q1 = math.pi / 60
@@ -174,8 +174,18 @@ def estimate_workspace(
     for name, value in (("voxel_size", voxel_size), ("cell", cell)):
         if not (math.isfinite(value) and value > 0):
             raise InputError(f"workspace: {name} must be a positive length in m. Got: {value}")
-    rng = np.random.default_rng(seed)
+    from lynxplan import guards
+
+    samples = guards.count("workspace samples", samples)
+    guards.positive_length("workspace voxel_size", voxel_size)
+    guards.positive_length("workspace cell", cell)
+    rng = np.random.default_rng(guards.seed("workspace seed", seed))
     reach = geometry.max_reach
+    guards.grid_cells("workspace planar grid cells", 2 * reach, cell, 2)
+    if 2 * reach / voxel_size + 2 > 2**20:  # voxel indices (per axis cubed) must fit an int64
+        raise OutOfRangeError(
+            "workspace voxel_size", voxel_size, f">= {2 * reach / 2**20:.3g} m for this arm"
+        )
     n_cells = math.ceil(2 * reach / cell) + 2
     planar_counts = np.zeros((n_cells, n_cells), dtype=bool)  # (z, signed r) over [-reach, reach]
     voxels: set[int] = set()

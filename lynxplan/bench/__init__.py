@@ -20,6 +20,8 @@ SECTIONS: dict[str, str] = {
     "collision": "lynxplan.bench.collision",
     "task": "lynxplan.bench.task",
     "cold": "lynxplan.bench.cold",
+    "plan": "lynxplan.bench.plan",
+    "serve": "lynxplan.bench.serve",
     "robots": "lynxplan.bench.robots",
 }
 

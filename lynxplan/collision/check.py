@@ -45,8 +45,9 @@ from typing import Any, NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.collision.world import CollisionWorld, _configurations
-from lynxplan.exceptions import NonFiniteInputError, ShapeError, TrajectoryCheckError
+from lynxplan.exceptions import LynxplanError, NonFiniteInputError, ShapeError, TrajectoryCheckError
 
 #: Bisection levels of one sample interval before it is reported as not certified.
 MAX_BISECTION_DEPTH = 40
@@ -256,7 +257,7 @@ def check_trajectory(
         ShapeError, NonFiniteInputError: bad array shapes or values.
         TrajectoryCheckError: times not strictly increasing, or a bad acceleration bound.
     """
-    config = _configurations(q, world.model.nq)
+    config = _configurations(guards.configurations("q", q, dof=world.model.nq), world.model.nq)
     times, segments = _check_times(t, segment, len(config))
     margins = _interpolation_margins(world, acceleration_bound, times)
     checker = _Checker(world, config, times)
@@ -302,7 +303,7 @@ def clearance_profile(world: CollisionWorld, q: Any) -> np.ndarray:
     Branch and bound per sample: exact queries only for primitives whose lower bound is below the
     best distance found. q: shape (N, nq), in [rad] -> shape (N, n_obstacles), in [m].
     """
-    config = _configurations(q, world.model.nq)
+    config = _configurations(guards.configurations("q", q, dof=world.model.nq), world.model.nq)
     poses = world.primitive_poses(config)
     bounds = world.lower_bounds(poses)
     profile = np.full((len(config), len(world.obstacles)), np.inf)
@@ -321,7 +322,7 @@ def clearance_profile(world: CollisionWorld, q: Any) -> np.ndarray:
 
 
 def _check_times(t: Any, segment: Any, count: int) -> tuple[np.ndarray, np.ndarray]:
-    times = np.asarray(t, dtype=float)
+    times = guards.float_array("t", t)
     if times.shape != (count,):
         raise ShapeError("t", f"({count},)", times.shape)
     if not np.isfinite(times).all():
@@ -336,6 +337,8 @@ def _check_times(t: Any, segment: Any, count: int) -> tuple[np.ndarray, np.ndarr
     if segment is None:
         return times, np.zeros(count, dtype=np.intp)
     segments = np.asarray(segment)
+    if segments.dtype == object:
+        raise TrajectoryCheckError("segment indices must be integers. Got objects")
     if segments.shape != (count,):
         raise ShapeError("segment", f"({count},)", segments.shape)
     if not np.issubdtype(segments.dtype, np.integer):
@@ -347,7 +350,16 @@ def _interpolation_margins(world: CollisionWorld, bound: Any, times: np.ndarray)
     """Per interval, the largest distance by which the real motion may leave the linear one, [m]."""
     if bound is None or len(times) < 2:
         return np.zeros(max(len(times) - 1, 0))
-    acceleration = np.broadcast_to(np.asarray(bound, dtype=float), (world.model.nq,))
+    try:
+        acceleration = np.broadcast_to(
+            guards.float_array("acceleration_bound", bound), (world.model.nq,)
+        )
+    except ValueError as exc:
+        if isinstance(exc, LynxplanError):
+            raise
+        raise ShapeError(
+            "acceleration_bound", f"() or ({world.model.nq},)", np.shape(bound)
+        ) from None
     if not np.isfinite(acceleration).all() or (acceleration < 0).any():
         raise TrajectoryCheckError(
             f"acceleration_bound must be finite and >= 0. Got: {np.asarray(bound).tolist()}"

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.exceptions import InvalidObstacleError, NonFiniteInputError, ShapeError
 
 #: ``max |R^T R - I|`` accepted for an obstacle's rotation matrix.
@@ -19,11 +20,12 @@ _ROTATION_TOLERANCE = 1e-9
 
 
 def _vector(name: str, value: Any, length: int = 3) -> np.ndarray:
-    array = np.array(value, dtype=float)
+    array = np.array(guards.float_array(name, value))
     if array.shape != (length,):
         raise ShapeError(name, f"({length},)", array.shape)
     if not np.isfinite(array).all():
         raise NonFiniteInputError(name)
+    guards.length(name, float(np.abs(array).max()))
     array.setflags(write=False)
     return array
 
@@ -31,7 +33,7 @@ def _vector(name: str, value: Any, length: int = 3) -> np.ndarray:
 def _rotation(name: str, value: Any) -> np.ndarray:
     if value is None:
         value = np.eye(3)
-    array = np.array(value, dtype=float)
+    array = np.array(guards.float_array(f"{name}.rotation", value))
     if array.shape != (3, 3):
         raise ShapeError(f"{name}.rotation", "(3, 3)", array.shape)
     if not np.isfinite(array).all():
@@ -46,6 +48,11 @@ def _rotation(name: str, value: Any) -> np.ndarray:
 
 
 def _positive(obstacle: str, what: str, value: float) -> float:
+    value = guards.real(f"obstacle {obstacle!r} {what}", value)
+    if value > guards.MAX_ABS_LENGTH:
+        raise InvalidObstacleError(
+            obstacle, f"{what} = {value:g} m is larger than {guards.MAX_ABS_LENGTH:g} m"
+        )
     if not np.isfinite(value) or value <= 0:
         raise InvalidObstacleError(obstacle, f"{what} must be positive and finite. Got: {value!r}")
     return float(value)

@@ -32,6 +32,30 @@ def print_json(value: Any) -> None:
     sys.stdout.write(json.dumps(to_jsonable(value), indent=2) + "\n")
 
 
+#: Longest JSON value accepted on the command line, in characters.
+MAX_JSON_ARGUMENT = 100_000
+
+
+def parse_json_numbers(text: str, name: str, what: str) -> np.ndarray:
+    """A JSON nested list of numbers from the command line -> float array.
+
+    Raises:
+        InputError: naming ``name`` for text that is too long, not JSON, nested too deeply, or
+            not a (rectangular) list of numbers.
+    """
+    if len(text) > MAX_JSON_ARGUMENT:
+        raise InputError(f"{name}: {len(text)} characters, more than {MAX_JSON_ARGUMENT}")
+    try:
+        value = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise InputError(f"{name}: not {what} ({exc.msg} at character {exc.pos})") from None
+    except RecursionError:
+        raise InputError(f"{name}: not {what} (JSON nested too deeply)") from None
+    from lynxplan import guards
+
+    return guards.float_array(name, value)
+
+
 def parse_finite(text: str, name: str) -> float:
     """Parse a float command-line value; InputError naming ``name`` if not a finite number."""
     try:

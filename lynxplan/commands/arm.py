@@ -7,13 +7,13 @@ lengths in the requested length unit, orientation errors always in radians.
 from __future__ import annotations
 
 import argparse
-import json
 from typing import Any
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.commands import robots as robots_cmd
-from lynxplan.commands._output import parse_finite, print_json
+from lynxplan.commands._output import parse_finite, parse_json_numbers, print_json
 from lynxplan.exceptions import InputError, ShapeError
 from lynxplan.units import LENGTH_UNITS, angle_factor, length_factor
 
@@ -77,7 +77,8 @@ def handle_fk(args: argparse.Namespace) -> int:
     units = _units(args)
     if len(args.q) != 5:
         raise InputError(f"fk: expected 5 joint angles q1..q5, got {len(args.q)}")
-    q = np.array([parse_finite(text, f"q{i + 1}") for i, text in enumerate(args.q)])
+    check = guards.angle_deg if args.deg else guards.angle
+    q = np.array([check(f"q{i + 1}", parse_finite(t, f"q{i + 1}")) for i, t in enumerate(args.q)])
     T = tool_pose(q * angle_factor(units["angle"]), load_arm().geometry)
     T[:3, 3] /= length_factor(units["length"])
     if args.json:
@@ -90,18 +91,15 @@ def handle_fk(args: argparse.Namespace) -> int:
 
 
 def parse_pose(text: str, length_unit: str) -> np.ndarray:
-    """JSON 4x4 or 3x4 nested list -> (4, 4) pose in [m]."""
-    try:
-        value = json.loads(text)
-        pose = np.array(value, dtype=float)
-    except (json.JSONDecodeError, TypeError, ValueError) as exc:
-        raise InputError(f"--pose: not a JSON 4x4 list of numbers ({exc})") from None
+    """JSON 4x4 or 3x4 nested list -> (4, 4) pose in [m], checked by :func:`guards.poses`."""
+    pose = parse_json_numbers(text, "--pose", "a JSON 4x4 (or 3x4) nested list of numbers")
     if pose.shape == (3, 4):
         pose = np.vstack([pose, [0.0, 0.0, 0.0, 1.0]])
     if pose.shape != (4, 4):
         raise ShapeError("--pose", "(4, 4) or (3, 4)", pose.shape)
+    guards.finite_array("--pose", pose)
     pose[:3, 3] *= length_factor(length_unit)
-    return pose
+    return guards.poses("--pose", pose, batch=False)
 
 
 def handle_ik(args: argparse.Namespace) -> int:
@@ -117,16 +115,16 @@ def handle_ik(args: argparse.Namespace) -> int:
     pose = parse_pose(args.pose, units["length"])
     reference = None
     if args.reference is not None:
-        try:
-            reference = np.array(json.loads(args.reference), dtype=float) * scale
-        except (json.JSONDecodeError, TypeError, ValueError) as exc:
-            raise InputError(f"--reference: not a JSON list of 5 numbers ({exc})") from None
+        given = parse_json_numbers(args.reference, "--reference", "a JSON list of 5 numbers")
+        if given.shape != (5,):
+            raise ShapeError("--reference", "(5,)", given.shape)
+        reference = guards.angles("--reference", given * scale)
     result = load_arm().ik(
         pose,
         q_reference=reference,
         select=args.select,
         strict=args.strict,
-        orientation_tolerance=parse_finite(args.tolerance, "--tolerance"),
+        orientation_tolerance=guards.tolerance("--tolerance", args.tolerance, "rad"),
     )
     listed = [i for i, s in enumerate(result.solutions) if args.all or s.within_limits]
     length = length_factor(units["length"])

@@ -7,6 +7,7 @@ from typing import Any
 
 from lynxplan.bench import SECTIONS, run_sections
 from lynxplan.commands._output import print_json
+from lynxplan.exceptions import InputError
 
 
 def register(subparsers: Any) -> None:
@@ -21,6 +22,9 @@ def register(subparsers: Any) -> None:
         help="fresh-process start-up times only (section cold): fk, run ok_task --quick, "
         "import pinocchio",
     )
+    parser.add_argument(
+        "sections", nargs="*", metavar="SECTION", help="sections to run, e.g. `bench serve`"
+    )
     parser.add_argument("--quick", action="store_true", help="fewer repeats (smoke test)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
     parser.set_defaults(handler=handle)
@@ -28,7 +32,10 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the benchmark and print the figures."""
-    sections = ["cold"] if args.cold else args.section
+    unknown = sorted(set(args.sections) - set(SECTIONS))
+    if unknown:
+        raise InputError(f"unknown bench section {unknown[0]!r}; sections: {', '.join(SECTIONS)}")
+    sections = ["cold"] if args.cold else (args.section or []) + args.sections or None
     figures = run_sections(sections, quick=args.quick)
     if args.json:
         print_json({"figures": [f._asdict() for f in figures]})

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.commands._output import parse_finite, print_json
 from lynxplan.exceptions import InputError
 
@@ -52,13 +53,28 @@ def register(subparsers: Any) -> None:
     ws.set_defaults(handler=handle_workspace)
 
 
+def _angle_deg(text: str, name: str) -> float:
+    return guards.angle_deg(name, parse_finite(text, name))
+
+
+def _length_mm(text: str, name: str) -> float:
+    return guards.length(name, parse_finite(text, name), 1e-3, "mm")
+
+
+def _pose_mm_deg(xc: str, yc: str, alpha: str, prefix: str = "") -> tuple[float, float, float]:
+    """``XC YC ALPHA`` from the command line in [mm, mm, deg], each checked against its range."""
+    return (
+        _length_mm(xc, f"{prefix}XC"),
+        _length_mm(yc, f"{prefix}YC"),
+        _angle_deg(alpha, f"{prefix}ALPHA"),
+    )
+
+
 def handle_ik(args: argparse.Namespace) -> int:
     """Print the 8 working modes of the pose."""
     from lynxplan.parallel import WORKING_MODES, pose_from_mm_deg, solve_ik
 
-    pose = pose_from_mm_deg(
-        parse_finite(args.xc, "XC"), parse_finite(args.yc, "YC"), parse_finite(args.alpha, "ALPHA")
-    )
+    pose = pose_from_mm_deg(*_pose_mm_deg(args.xc, args.yc, args.alpha))
     solutions = np.degrees(solve_ik(pose))
     if args.json:
         print_json({"solutions": solutions, "modes": list(WORKING_MODES)})
@@ -78,9 +94,10 @@ def handle_fk(args: argparse.Namespace) -> int:
         solve_fk,
     )
 
-    theta = np.radians([parse_finite(getattr(args, n), n.upper()) for n in ("t1", "t2", "t3")])
+    theta = np.radians([_angle_deg(getattr(args, n), n.upper()) for n in ("t1", "t2", "t3")])
     if args.near is not None:
-        near = [parse_finite(v, n) for v, n in zip(args.near, ("XC", "YC", "ALPHA"), strict=True)]
+        xc, yc, alpha = args.near
+        near = _pose_mm_deg(xc, yc, alpha, prefix="--near ")
         poses = nearest_assembly_mode(theta, pose_from_mm_deg(*near))[None]
         labels = [""]
     else:
@@ -118,8 +135,8 @@ def handle_workspace(args: argparse.Namespace) -> int:
     from lynxplan.parallel.workspace import constant_orientation_workspace
     from lynxplan.scenarios.outputs import staged_outputs
 
-    alpha_deg = parse_finite(args.alpha, "--alpha")
-    step = parse_finite(args.step, "--step")
+    alpha_deg = _angle_deg(args.alpha, "--alpha")
+    step = guards.positive_length("--step", parse_finite(args.step, "--step"), 1e-3, "mm")
     mode = _mode_argument(args.mode)
     workspace = constant_orientation_workspace(math.radians(alpha_deg), step=step * 1e-3, mode=mode)
     suffix = "" if mode is None else f"_mode{mode + 1}"

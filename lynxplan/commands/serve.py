@@ -32,7 +32,8 @@ def handle(args: argparse.Namespace) -> int:
     """Start the server (blocks until interrupted)."""
     import uvicorn
 
-    from lynxplan.service.app import ServiceConfig, create_app
+    from lynxplan.service.app import create_app
+    from lynxplan.service.config import ServiceConfig
 
     token = _read_token(args.token_file)
     if token is None and not _is_loopback(args.host):
@@ -42,6 +43,7 @@ def handle(args: argparse.Namespace) -> int:
         )
     if args.workers < 1 or not 0 < args.port < 65536:
         raise InputError("--workers must be >= 1 and --port within 1..65535")
+    _check_data_dir(Path(args.data_dir))
     config = ServiceConfig(
         data_dir=Path(args.data_dir), workers=args.workers, token=token,
         max_body=int(args.max_body * 1024**2), max_batch=args.max_batch,
@@ -57,6 +59,17 @@ def handle(args: argparse.Namespace) -> int:
         server_header=False,
     )
     return 0
+
+
+def _check_data_dir(folder: Path) -> None:
+    """A data dir that can hold the job store (one-line error before the server starts)."""
+    import sqlite3
+
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+        sqlite3.connect(str(folder / "lynxplan.sqlite3")).close()
+    except (OSError, sqlite3.Error) as exc:
+        raise InputError(f"cannot use --data-dir {folder}: {exc}") from exc
 
 
 def _read_token(path: str | None) -> str | None:

@@ -35,7 +35,6 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from lynxplan._arrays import as_rows
 from lynxplan.constants import (
     PARALLEL_FK_DUPLICATE_TOLERANCE,
     PARALLEL_FK_UNIT_CIRCLE_TOLERANCE,
@@ -44,7 +43,6 @@ from lynxplan.constants import (
 from lynxplan.exceptions import (
     DegenerateForwardKinematicsError,
     NoAssemblyModeError,
-    NonFiniteInputError,
     ShapeError,
 )
 from lynxplan.parallel._legs import (
@@ -83,7 +81,10 @@ class ParallelFKResult(NamedTuple):
 
 
 def _as_thetas(theta: np.ndarray) -> np.ndarray:
-    return as_rows(theta, 3, "theta")
+    """Actuated angles (3,) or (N, 3) in range (:func:`lynxplan.guards.configurations`)."""
+    from lynxplan import guards
+
+    return guards.configurations("theta", theta, dof=3).reshape(-1, 3)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -357,9 +358,9 @@ def solve_fk_batch(
 def solve_fk(theta: np.ndarray, geometry: ParallelGeometry = _DEFAULT_GEOMETRY) -> ParallelFKResult:
     """All real assembly modes (0 to 6) for actuated angles ``theta``, shape (3,), in [rad],
     sorted by platform angle."""
-    array = np.asarray(theta, dtype=float)
-    if array.shape != (3,):
-        raise ShapeError("theta", "(3,)", array.shape)
+    array = _as_thetas(theta)
+    if np.ndim(theta) != 1:
+        raise ShapeError("theta", "(3,)", np.shape(theta))
     return solve_fk_batch(array, geometry)[0]
 
 
@@ -385,11 +386,11 @@ def nearest_assembly_mode(
     Raises:
         NoAssemblyModeError: no real assembly mode exists.
     """
-    reference = np.asarray(reference, dtype=float)
+    from lynxplan import guards
+
+    reference = guards.planar_poses("reference", reference)
     if reference.shape != (3,):
         raise ShapeError("reference", "(3,)", reference.shape)
-    if not np.all(np.isfinite(reference)):
-        raise NonFiniteInputError("reference")
     result = solve_fk(theta, geometry)
     if result.n_modes == 0:
         raise NoAssemblyModeError(tuple(float(t) for t in np.asarray(theta, dtype=float)))  # type: ignore[arg-type]

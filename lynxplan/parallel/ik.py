@@ -17,7 +17,6 @@ from typing import NamedTuple
 import numba
 import numpy as np
 
-from lynxplan._arrays import as_rows
 from lynxplan.constants import ACOS_CLAMP_TOLERANCE
 from lynxplan.exceptions import (
     LegUnreachableError,
@@ -45,8 +44,11 @@ def mode_index(mode: int | str) -> int:
                 f"unknown working mode {mode!r}; valid modes: {', '.join(WORKING_MODES)}"
             )
         return WORKING_MODES.index(mode)
-    if isinstance(mode, (bool, np.bool_)) or not 0 <= int(mode) < 8 or int(mode) != mode:
-        raise InputError(f"working mode index must be an integer in 0..7. Got: {mode}")
+    integral = isinstance(mode, (int, np.integer)) or (
+        isinstance(mode, (float, np.floating)) and float(mode).is_integer()
+    )
+    if isinstance(mode, (bool, np.bool_)) or not integral or not 0 <= int(mode) < 8:
+        raise InputError(f"working mode index must be an integer in 0..7. Got: {mode!r:.60}")
     return int(mode)
 
 
@@ -119,8 +121,11 @@ class ParallelIKResult(NamedTuple):
 def as_poses(
     poses: np.ndarray | list[float] | tuple[float, ...], name: str = "poses"
 ) -> np.ndarray:
-    """Validate poses: shape (3,) or (N, 3), finite -> float array (N, 3)."""
-    return as_rows(poses, 3, name)
+    """Validate poses: shape (3,) or (N, 3), in range (:func:`lynxplan.guards.planar_poses`)
+    -> float array (N, 3)."""
+    from lynxplan import guards
+
+    return np.ascontiguousarray(guards.planar_poses(name, poses).reshape(-1, 3))
 
 
 def solve_ik_batch(
@@ -153,9 +158,9 @@ def solve_ik(pose: np.ndarray, geometry: ParallelGeometry = _DEFAULT_GEOMETRY) -
     Raises:
         LegUnreachableError: naming the first leg that cannot reach and the range it spans.
     """
-    array = np.asarray(pose, dtype=float)
-    if array.shape != (3,):
-        raise ShapeError("pose", "(3,)", array.shape)
+    array = as_poses(pose, "pose")
+    if np.ndim(pose) != 1:
+        raise ShapeError("pose", "(3,)", np.shape(pose))
     result = solve_ik_batch(array, geometry)
     for i in range(3):
         if not result.reachable[0, i]:

@@ -118,9 +118,18 @@ def grid_axes(
         raise InputError(f"workspace grid step must be positive. Got: {step * 1e3:g} mm")
     if x_range[1] <= x_range[0] or y_range[1] <= y_range[0]:
         raise InputError(f"workspace region must have min < max. Got: x {x_range}, y {y_range} m")
+    from lynxplan import guards
+
+    cells = ((x_range[1] - x_range[0]) / step + 1) * ((y_range[1] - y_range[0]) / step + 1)
+    guards.check_size(f"workspace grid points for a {step * 1e3:.3g} mm step", cells, 9.0)
     axes = []
     for lo, hi in (x_range, y_range):
         n = math.floor((hi - lo) / step + 1e-9) + 1
+        if n < 2:
+            raise InputError(
+                f"workspace grid step {step * 1e3:g} mm is larger than the region "
+                f"({(hi - lo) * 1e3:g} mm): at least 2 grid points per axis are needed"
+            )
         if n > 20_000:
             raise InputError(
                 f"workspace grid step {step * 1e3:g} mm gives {n} points per axis (at most 20000)"
@@ -217,8 +226,9 @@ def constant_orientation_workspace(
     Raises:
         InputError: bad step or region, or a seed outside the mode's singularity-free workspace.
     """
-    if not math.isfinite(alpha):
-        raise NonFiniteInputError("alpha")
+    from lynxplan import guards
+
+    alpha = guards.angle("alpha", alpha)
     x, y = grid_axes(step, x_range, y_range)
     mask = reachable_stack(np.array([alpha]), x, y, geometry)[0]
     if mode is None:
@@ -293,6 +303,9 @@ def orientation_stack(
     y_range: tuple[float, float] = REPORT_Y_RANGE,
 ) -> OrientationStack:
     """Constant-orientation workspaces at each of ``alphas`` (K,) in [rad] on one grid."""
+    from lynxplan import guards
+
+    alphas = np.atleast_1d(guards.angles("alphas", alphas))
     x, y = grid_axes(step, x_range, y_range)
-    alphas = np.atleast_1d(np.asarray(alphas, dtype=float))
+    guards.check_size("orientation workspace grid points", alphas.size * x.size * y.size, 1.0)
     return OrientationStack(alphas, x, y, step, reachable_stack(alphas, x, y, geometry))

@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 from lynxplan.collision import CollisionWorld, Obstacle
-from lynxplan.exceptions import InputError, StateInCollisionError
+from lynxplan.exceptions import InputError, PlanningFailed, StateInCollisionError
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
 from lynxplan.planning.shortcut import DEFAULT_SHORTCUT_ITERATIONS, shortcut
@@ -144,7 +144,7 @@ class PlannedTrajectory:
 
     @property
     def min_clearance(self) -> float:
-        """Smallest exact distance along the path, in [m]."""
+        """Smallest exact distance at the waypoints and certification probes, in [m]."""
         return float(self.verification.min_clearance.clearance)
 
 
@@ -184,6 +184,22 @@ class Planner:
             if not (np.isfinite(limit).all() and (limit > 0).all()):
                 raise InputError(f"planner option max_{name} must be positive: {limit.tolist()}")
 
+    def _require_certifiable(self, q: np.ndarray, what: str) -> None:
+        """PlanningFailed at once (not after the time limit) when the conservative checker
+        cannot certify a start or goal that the exact check accepted."""
+        bounds = self.checker.pair_bounds(q)
+        if bounds.size and bounds.min() <= self.options.clearance + STALL_DISTANCE:
+            pair = int(np.argmin(bounds))
+            geometry, other = self.checker.pair_names[pair]
+            raise PlanningFailed(
+                0,
+                0,
+                0.0,
+                f"the {what} is too close to {other} ({geometry}) for the planner's conservative "
+                f"checker: lower bound {bounds[pair] * 1e3:.2f} mm, needs more than "
+                f"{(self.options.clearance + STALL_DISTANCE) * 1e3:.2f} mm",
+            )
+
     def _check_state(self, q: np.ndarray, what: str) -> None:
         require_clear(self.world, q, what, self.options.clearance)
 
@@ -209,6 +225,11 @@ class Planner:
         if not free:
             assert first_error is not None
             raise first_error
+        self._require_certifiable(q_start, "start")
+        certifiable = [k for k in free if self.checker.is_valid(goals.configurations[k])]
+        if not certifiable:
+            self._require_certifiable(goals.configurations[free[0]], "goal")
+        free = certifiable
         began = time.perf_counter()
         settings = RrtConnectSettings(
             self.options.step, self.options.goal_bias, self.options.max_nodes

@@ -166,7 +166,7 @@ def rrt_connect_kernel(
         length = math.sqrt(length)
         reached = edge_fraction(base, new, model, scratch, clearance)
         parent = other
-        pieces = max(1, int(math.ceil(length / step)))
+        pieces = max(1, math.ceil(length / step))
         for k in range(1, pieces + 1):
             s = k / pieces
             if s > reached:
@@ -254,11 +254,11 @@ def rrt_connect(
             break
         if status == NODE_LIMIT:
             raise PlanningFailed(
-                int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes}"
+                int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes} reached"
             )
         if elapsed >= time_limit:
             raise PlanningFailed(
-                int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s"
+                int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
     from_start = _branch(nodes, parents, 0, int(meta[1]))[::-1]
     to_goal = _branch(nodes, parents, 1, int(meta[2]))

@@ -26,6 +26,8 @@ from lynxplan.planning.validity import ValidityChecker, edge_fraction
 
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
+#: Random cuts stop after this many attempts in a row that changed nothing.
+DEFAULT_SHORTCUT_PATIENCE = 20
 #: Points closer than this in joint space are merged, in [rad].
 _MERGE_DISTANCE = 1e-9
 
@@ -64,18 +66,22 @@ def shortcut_kernel(
     scratch: Any,
     clearance: float,
     work: np.ndarray,
+    patience: int,
 ) -> int:
     """Partial shortcuts then vertex pruning, in place on path[:count]; returns the new count.
 
-    path: (capacity, nq) with capacity >= count + 2 * iterations; work: same shape.
+    path: (capacity, nq) with capacity >= count + 2 * iterations; work: same shape. The cuts stop
+    early after ``patience`` attempts in a row that changed nothing.
     """
     nq = path.shape[1]
     cumulative = np.empty(path.shape[0])
     first = np.empty(nq)
     second = np.empty(nq)
+    idle = 0
     for _ in range(iterations):
-        if count < 3:
+        if count < 3 or idle >= patience:
             break
+        idle += 1
         cumulative[0] = 0.0
         for k in range(1, count):
             cumulative[k] = cumulative[k - 1] + _distance(path[k - 1], path[k])
@@ -90,6 +96,7 @@ def shortcut_kernel(
             continue
         if edge_fraction(first, second, model, scratch, clearance) < 1.0:
             continue
+        idle = 0
         # New path: path[0..i1], first, second, path[i2+1..count-1].
         size = 0
         for k in range(i1 + 1):
@@ -118,17 +125,36 @@ def shortcut_kernel(
     return count
 
 
+def merge_collinear(path: np.ndarray) -> np.ndarray:
+    """The path without waypoints that lie on the straight line of their neighbours (RRT-Connect
+    adds one every step along a connection): the same straight segments, fewer waypoints."""
+    keep = [0]
+    for k in range(1, len(path) - 1):
+        before, after = path[k] - path[keep[-1]], path[k + 1] - path[k]
+        norm_before, norm_after = np.linalg.norm(before), np.linalg.norm(after)
+        if norm_before > 0 and norm_after > 0:
+            gap = np.linalg.norm(before / norm_before - after / norm_after)
+            if gap <= 1e-12:
+                continue
+        keep.append(k)
+    keep.append(len(path) - 1)
+    merged: np.ndarray = path[keep]
+    return merged
+
+
 def shortcut(
     checker: ValidityChecker,
     path: np.ndarray,
     *,
     seed: int,
     iterations: int = DEFAULT_SHORTCUT_ITERATIONS,
+    patience: int = DEFAULT_SHORTCUT_PATIENCE,
 ) -> np.ndarray:
     """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path.
 
     Deterministic for a given ``seed``; ``iterations`` random cuts are attempted.
     """
+    path = merge_collinear(path)
     count = len(path)
     capacity = count + 2 * iterations + 2
     buffer = np.zeros((capacity, path.shape[1]))
@@ -137,7 +163,15 @@ def shortcut(
     # A stream of its own: the planner's draws and the shortcutter's never overlap.
     state = _rng.seed_state(seed ^ 0x5DEECE66D)
     count = shortcut_kernel(
-        buffer, count, iterations, state, checker.model, checker.scratch, checker.clearance, work
+        buffer,
+        count,
+        iterations,
+        state,
+        checker.model,
+        checker.scratch,
+        checker.clearance,
+        work,
+        patience,
     )
     result: np.ndarray = buffer[:count].copy()
     return result

@@ -116,7 +116,7 @@ def _toppra_law(
 
 
 def _times(duration: float, rate: float) -> np.ndarray:
-    count = max(2, int(math.ceil(duration * rate - 1e-9)) + 1)
+    count = max(2, math.ceil(duration * rate - 1e-9) + 1)
     return np.linspace(0.0, duration, count)
 
 

@@ -25,7 +25,10 @@ Edges (conservative advancement)
     distance at most ``R_gj`` from joint j's axis moves at most ``sum_j R_gj |dq_j|`` (proof in
     :mod:`lynxplan.collision.check`); a pair whose bound is ``b`` at ``s`` therefore stays above
     ``clearance`` for a step ``ds <= (b - clearance) / L_p`` with ``L_p`` the pair's motion per
-    unit ``s`` (the sum of both primitives' for a self pair). The edge is walked with the largest
+    unit ``s``. For a self pair only the joints that move one body and not the other count
+    (the distance depends on the relative pose only; common ancestors move both rigidly), and a
+    fixed cylinder coaxial with the first joint (the base) makes that joint irrelevant
+    (:func:`_pair_rates`). The edge is walked with the largest
     such step until ``s = 1``, or stopped where a bound comes within :data:`STALL_DISTANCE` of the
     clearance. Every certified part of an edge is collision-free for the real geometry with
     distance >= ``clearance``: no sampling resolution, nothing skipped between samples.
@@ -90,7 +93,7 @@ class ValidityChecker:
             half,
             np.linalg.norm(half, axis=1),
             pairs,
-            np.stack([p.reach for p in world.links]),
+            _pair_rates(world, pairs),
             kinds,
             centres,
             rotations,
@@ -128,18 +131,22 @@ class ValidityChecker:
 
 
 def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
-    """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates."""
+    """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
+    counters (edge checks, advancement steps, pair bounds evaluated)."""
     joints, prims, pairs, nq = len(model[0]), len(model[4]), len(model[8]), model[9].shape[1]
+    del prims
     return (
         np.empty((joints, 4, 4)),
         np.empty((4, 4)),
         np.zeros((4, 4)),
-        np.empty((prims, 4, 4)),
+        np.empty((len(model[4]), 4, 4)),
         np.empty(pairs),
         np.empty(pairs),
-        np.empty(prims),
+        np.empty(pairs),
         np.empty(nq),
         np.empty((3, 3)),
+        np.zeros(3, dtype=np.int64),
+        np.zeros(len(model[4]), dtype=np.int64),
     )
 
 
@@ -168,6 +175,68 @@ def _pairs(world: CollisionWorld) -> tuple[np.ndarray, list[tuple[str, str]]]:
             rows.append((a, b, 1))
             names.append((links[a].geometry, f"self:{links[b].geometry}"))
     return np.array(rows, dtype=np.int64).reshape(-1, 3), names
+
+
+def _ancestors(model: Any, joint: int) -> set[int]:
+    """Configuration indices of the joints that move a body on ``joint``."""
+    found = set()
+    while joint > 0:
+        found.add(int(model.joints[joint].idx_q))
+        joint = int(model.parents[joint])
+    return found
+
+
+def _symmetric_about_root_axis(world: CollisionWorld, g: int) -> int | None:
+    """The configuration index of the first joint if fixed primitive g is a cylinder coaxial
+    with it (turning that joint then cannot change any distance to g), else None."""
+    model, link = world.model, world.links[g]
+    if link.joint != 0 or link.kind != "cylinder" or model.njoints < 2 or model.parents[1] != 0:
+        return None
+    axis_index = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}.get(
+        model.joints[1].shortname()
+    )
+    if axis_index is None:
+        return None
+    placement = np.array(model.jointPlacements[1].homogeneous)
+    joint_axis, joint_origin = placement[:3, axis_index], placement[:3, 3]
+    cylinder_axis, centre = link.placement[:3, 2], link.placement[:3, 3]
+    offset = centre - joint_origin
+    off_axis = offset - (offset @ joint_axis) * joint_axis
+    if np.linalg.norm(np.cross(joint_axis, cylinder_axis)) > 1e-12:
+        return None
+    if np.linalg.norm(off_axis) > 1e-12:
+        return None
+    return int(model.joints[1].idx_q)
+
+
+def _pair_rates(world: CollisionWorld, pairs: np.ndarray) -> np.ndarray:
+    """Motion of each pair per radian of each joint, shape (P, nq), in [m/rad].
+
+    Obstacle pair: the primitive's reach about each joint. Self pair: the distance between two
+    bodies depends only on their relative pose, so joints that move both (common ancestors)
+    do not count; each other joint counts with the reach of the body it moves. A fixed
+    cylinder coaxial with the first joint (the AL5's base) is symmetric about it: that joint
+    does not count either.
+    """
+    model = world.model
+    rates = np.zeros((len(pairs), model.nq))
+    for p, (a, b, is_self) in enumerate(pairs.tolist()):
+        first = world.links[a]
+        if not is_self:
+            rates[p] = first.reach
+            continue
+        second = world.links[b]
+        only_a = _ancestors(model, first.joint) - _ancestors(model, second.joint)
+        only_b = _ancestors(model, second.joint) - _ancestors(model, first.joint)
+        for j in only_a:
+            rates[p, j] += first.reach[j]
+        for j in only_b:
+            rates[p, j] += second.reach[j]
+        for g in (a, b):
+            symmetric = _symmetric_about_root_axis(world, g)
+            if symmetric is not None:
+                rates[p, symmetric] = 0.0
+    return rates
 
 
 def _obstacle_arrays(world: CollisionWorld) -> tuple[np.ndarray, ...]:
@@ -210,30 +279,44 @@ def _compose(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
 
 
 @numba.njit(cache=True)
-def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
-    """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
-    axes, index_q, parents, joint_placements, prim_joints, prim_placements = model[:6]
-    world, local, rotation, out = scratch[0], scratch[1], scratch[2], scratch[3]
-    joints = joint_placements.shape[0]
+def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
+    """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4).
+
+    The joint rotation is applied to the placement's columns directly (a rotation about one
+    axis mixes two columns), then composed with the parent's pose.
+    """
+    axes, index_q, parents, joint_placements = model[:4]
+    world, local = scratch[0], scratch[1]
     for i in range(4):
         for j in range(4):
             world[0, i, j] = 1.0 if i == j else 0.0
-    for j in range(1, joints):
+    for j in range(1, joint_placements.shape[0]):
         angle = q[index_q[j]]
         c, s = math.cos(angle), math.sin(angle)
         a = axes[j]
         i1, i2 = (a + 1) % 3, (a + 2) % 3
-        rotation[:, :] = 0.0
-        rotation[a, a] = 1.0
-        rotation[3, 3] = 1.0
-        rotation[i1, i1] = c
-        rotation[i2, i2] = c
-        rotation[i1, i2] = -s
-        rotation[i2, i1] = s
-        _compose(joint_placements[j], rotation, local)
+        placement = joint_placements[j]
+        for r in range(3):
+            first, second = placement[r, i1], placement[r, i2]
+            local[r, i1] = c * first + s * second
+            local[r, i2] = c * second - s * first
+            local[r, a] = placement[r, a]
+            local[r, 3] = placement[r, 3]
         _compose(world[parents[j]], local, world[j])
-    for g in range(prim_joints.shape[0]):
-        _compose(world[prim_joints[g]], prim_placements[g], out[g])
+
+
+@numba.njit(cache=True)
+def primitive_pose(g: int, model: Any, scratch: Any) -> None:
+    """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
+    _compose(scratch[0][model[4][g]], model[5][g], scratch[3][g])
+
+
+@numba.njit(cache=True)
+def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
+    """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
+    joint_poses(q, model, scratch)
+    for g in range(model[4].shape[0]):
+        primitive_pose(g, model, scratch)
 
 
 @numba.njit(cache=True)
@@ -254,13 +337,11 @@ def _separating_axis_gap(
     for i in range(3):  # axes of box a
         proj = abs(pa[0, i] * t0 + pa[1, i] * t1 + pa[2, i] * t2)
         gap = proj - ha[i] - hb[0] * r[i, 0] - hb[1] * r[i, 1] - hb[2] * r[i, 2]
-        if gap > best:
-            best = gap
+        best = max(best, gap)
     for j in range(3):  # axes of box b
         proj = abs(pb[0, j] * t0 + pb[1, j] * t1 + pb[2, j] * t2)
         gap = proj - hb[j] - ha[0] * r[0, j] - ha[1] * r[1, j] - ha[2] * r[2, j]
-        if gap > best:
-            best = gap
+        best = max(best, gap)
     if best >= EDGE_AXES_BELOW:
         return best
     for i in range(3):  # cross products a_i x b_j, normalised
@@ -278,8 +359,7 @@ def _separating_axis_gap(
                 gap -= ha[k] * abs(l0 * pa[0, k] + l1 * pa[1, k] + l2 * pa[2, k])
                 gap -= hb[k] * abs(l0 * pb[0, k] + l1 * pb[1, k] + l2 * pb[2, k])
             gap /= norm
-            if gap > best:
-                best = gap
+            best = max(best, gap)
     return best
 
 
@@ -349,31 +429,40 @@ def edge_fraction(
     Each pair keeps the parameter up to which it is certified and is re-evaluated only when the
     walk reaches it. Returns -1 if q_a itself is not valid. Proof: module docstring.
     """
-    pairs, reach = model[8], model[9]
-    certified_until, rate, q = scratch[5], scratch[6], scratch[7]
+    pairs, pair_rates = model[8], model[9]
+    certified_until, speed, q = scratch[5], scratch[6], scratch[7]
     nq = q_a.shape[0]
-    for g in range(rate.shape[0]):
+    for p in range(pairs.shape[0]):
         total = 0.0
         for j in range(nq):
-            total += reach[g, j] * abs(q_b[j] - q_a[j])
-        rate[g] = total
+            total += pair_rates[p, j] * abs(q_b[j] - q_a[j])
+        speed[p] = total
     for p in range(pairs.shape[0]):
         certified_until[p] = 0.0
+    counters, fresh = scratch[9], scratch[10]
+    counters[0] += 1
+    fresh[:] = 0
     s = 0.0
+    step = 0
     while True:
+        counters[1] += 1
+        step += 1
         for j in range(nq):
             q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-        primitive_poses(q, model, scratch)
+        joint_poses(q, model, scratch)
         nearest = np.inf
         for p in range(pairs.shape[0]):
             if certified_until[p] <= s:
+                counters[2] += 1
+                # Primitive poses on demand: most steps re-evaluate one or two pairs.
+                for g in (pairs[p, 0], pairs[p, 1] if pairs[p, 2] == 1 else -1):
+                    if g >= 0 and fresh[g] != step:
+                        primitive_pose(g, model, scratch)
+                        fresh[g] = step
                 slack = pair_bound(p, model, scratch) - clearance
                 if slack <= STALL_DISTANCE:
                     return s if s > 0.0 else -1.0
-                speed = rate[pairs[p, 0]]
-                if pairs[p, 2] == 1:
-                    speed += rate[pairs[p, 1]]
-                certified_until[p] = s + slack / speed if speed > 0.0 else np.inf
+                certified_until[p] = s + slack / speed[p] if speed[p] > 0.0 else np.inf
             nearest = min(nearest, certified_until[p])
         if nearest >= 1.0:
             return 1.0

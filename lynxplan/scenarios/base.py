@@ -52,9 +52,10 @@ def located_error(loc: tuple[int | str, ...], message: str, value: Any = None) -
 
 
 class StrictModel(BaseModel):
-    """Base of every scenario schema: unknown keys are errors, values are frozen."""
+    """Base of every scenario schema: unknown keys are errors, values are frozen, and NaN or
+    infinity is refused in every float field (issue 12: a NaN tolerance disables a check)."""
 
-    model_config = ConfigDict(extra="forbid", frozen=True)
+    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
 
 
 class Units(StrictModel):

@@ -22,6 +22,7 @@ KIND_MODULES: dict[str, str] = {
     "parallel_ik": "lynxplan.scenarios.parallel_ik",
     "parallel_workspace": "lynxplan.scenarios.parallel_workspace",
     "singularity": "lynxplan.scenarios.singularity",
+    "plan": "lynxplan.scenarios.plan",
 }
 
 

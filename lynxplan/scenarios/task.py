@@ -23,6 +23,7 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
     segments:
       - {from: A, to: B, motion: line, orientation: consistent}
       - {to: C, motion: free, timing: auto}   # from: defaults to the previous segment's end
+      - {to: A, motion: plan}                 # planned around the obstacles (lynxplan.plan)
     writing_plane: {point: [0.5, 10.3, 1.26], tilt: 20, size: [10, 8]}   # drawn only
     outputs: {plots: true, html: true}
     expect:
@@ -206,7 +207,10 @@ class SegmentEntry(StrictModel):
         None, alias="from", description="Start waypoint (default: the previous segment's end)."
     )
     to: str = Field(description="Target waypoint name.")
-    motion: Literal["free", "line"] = Field(description="Joint-space or Cartesian straight line.")
+    motion: Literal["free", "line", "plan"] = Field(
+        description="Joint-space or Cartesian straight line, or plan: a collision-free motion "
+        "found by lynxplan.plan (straight joint pieces through planned via points)."
+    )
     timing: Timing | None = Field(
         None, description="{tt, ta} or auto (shortest within limits); default: the file's timing."
     )

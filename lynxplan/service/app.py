@@ -4,14 +4,12 @@
 from __future__ import annotations
 
 import asyncio
-import hmac
 import mimetypes
 import platform
+import time
 from collections.abc import AsyncIterator
 from contextlib import asynccontextmanager
-from dataclasses import dataclass
 from importlib import resources
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -19,20 +17,23 @@ from fastapi import FastAPI, Query, Request
 from fastapi.exceptions import RequestValidationError
 from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import FileResponse, HTMLResponse, Response
-from starlette.types import ASGIApp, Receive, Scope, Send
 
 from lynxplan import __version__
 from lynxplan.exceptions import LynxplanError
 from lynxplan.service import compute, inputs, wire
+from lynxplan.service.auth import TokenMiddleware
+from lynxplan.service.config import ServiceConfig
 from lynxplan.service.jobs import FINAL_STATES, RunManager, validate_scenario
 from lynxplan.service.problems import Problem, problem_response
 from lynxplan.service.robots import describe_robot, get_robot, robot_names
 from lynxplan.service.schemas import openapi_body
 
 API_VERSION = 1
-#: Paths answered without a token: the liveness probe and the (data-free) web page.
-PUBLIC_PATHS = ("/health", "/", "/favicon.ico")
-PUBLIC_PREFIXES = ("/static/",)
+#: Hot routes served by plain Starlette routes in front of their FastAPI twins (see
+#: :func:`_fast_routes`); each endpoint takes only the request.
+FAST_PATHS = ("/ik", "/fk", "/check", "/trajectory")
+#: Period of the store checks of a long-polling GET /runs/{id}?wait=..., in [s].
+RUN_POLL = 0.005
 #: Batches at least this large are solved off the event loop (or on Dask when configured).
 THREAD_BATCH = 2_000
 SCENARIO_MEDIA_TYPES = (
@@ -43,59 +44,6 @@ SCENARIO_MEDIA_TYPES = (
     "text/x-yaml",
     "text/plain",
 )
-
-
-@dataclass(frozen=True)
-class ServiceConfig:
-    """Server settings.
-
-    Attributes:
-        data_dir: Job store and artifacts folder.
-        workers: Run worker processes.
-        token: Bearer token required on every request but /health (None: no check).
-        max_body: Largest request body, in [bytes].
-        max_batch: Largest batch (poses / configurations) in one request.
-        max_json_batch: Largest batch in a JSON body (larger ones must be binary).
-        dask_scheduler: Dask scheduler address, or None for the local pool.
-        dask_batch: /ik batches at least this large go to Dask when configured.
-        run_timeout: Wall-clock limit of one run, in [s].
-        run_memory: Address-space limit of a run worker, in [bytes] (0: none).
-    """
-
-    data_dir: Path
-    workers: int = 1
-    token: str | None = None
-    max_body: int = 64 * 1024**2
-    max_batch: int = 1_000_000
-    max_json_batch: int = 20_000
-    dask_scheduler: str | None = None
-    dask_batch: int = 50_000
-    run_timeout: float = 600.0
-    run_memory: int = 8 * 1024**3
-    max_scenario: int = 1024**2
-
-
-class TokenMiddleware:
-    """Bearer-token check (constant time) on every request except :data:`PUBLIC_PATHS`."""
-
-    def __init__(self, app: ASGIApp, token: str) -> None:
-        self.app = app
-        self.expected = f"Bearer {token}".encode()
-
-    async def __call__(self, scope: Scope, receive: Receive, send: Send) -> None:
-        path = scope.get("path", "")
-        if scope["type"] != "http" or path in PUBLIC_PATHS or path.startswith(PUBLIC_PREFIXES):
-            await self.app(scope, receive, send)
-            return
-        presented = b""
-        for key, value in scope["headers"]:
-            if key == b"authorization":
-                presented = value
-        if not hmac.compare_digest(presented, self.expected):
-            detail = "missing bearer token" if not presented else "invalid bearer token"
-            await problem_response(401, detail, "Authorization", path)(scope, receive, send)
-            return
-        await self.app(scope, receive, send)
 
 
 def create_app(config: ServiceConfig) -> FastAPI:
@@ -118,10 +66,14 @@ def create_app(config: ServiceConfig) -> FastAPI:
         version=__version__,
         lifespan=lifespan,
         description="Kinematics, collision checks, trajectories and scenario runs.",
+        docs_url=None,  # FastAPI's Swagger page loads its assets from a CDN: served below
+        redoc_url=None,
     )
     _install_error_handlers(app)
     if config.token:
         app.add_middleware(TokenMiddleware, token=config.token)
+
+    view_lock = asyncio.Lock()
 
     def runs() -> RunManager:
         return state["runs"]
@@ -161,7 +113,9 @@ def create_app(config: ServiceConfig) -> FastAPI:
 
     # -- kinematics ----------------------------------------
     @app.post("/fk", tags=["kinematics"], openapi_extra=openapi_body("FkRequest", binary=True))
-    async def fk(request: Request, robot: str = Query("al5")) -> Response:
+    async def fk(request: Request) -> Response:
+        # Query options are read by hand: FastAPI's parameter machinery costs ~0.3 ms a request.
+        robot = request.query_params.get("robot", "al5") if request.scope["query_string"] else "al5"
         if wire.is_binary(request):
             body: dict[str, Any] = {"robot": robot}
             q_value: Any = wire.decode_binary(
@@ -176,13 +130,20 @@ def create_app(config: ServiceConfig) -> FastAPI:
         q = wire.as_array(q_value, "q", (5,), limit=batch_limit(request))
         result = await _maybe_threaded(len(q) if q.ndim == 2 else 1, compute.fk_arrays, arm, q)
         if wire.wants_binary(request):
-            return wire.npz_response({"T": result["T"]}, {"residual": result["residual"]})
+            return wire.arrays_response(
+                request, {"T": result["T"]}, {"residual": result["residual"]}
+            )
         return wire.json_response(result)
 
     @app.post("/ik", tags=["kinematics"], openapi_extra=openapi_body("IkRequest", binary=True))
     async def ik(
-        request: Request, robot: str = Query("al5"), approach_only: bool = Query(False)
+        request: Request,
     ) -> Response:
+        start = time.perf_counter()
+        params = request.query_params if request.scope["query_string"] else {}
+        robot = params.get("robot", "al5")
+        approach_only = inputs.query_flag(params, "approach_only", False)
+        verify = inputs.query_flag(params, "verify", True)
         if wire.is_binary(request):
             raw = await wire.read_body(request, config.max_body)
             body: dict[str, Any] = {"robot": robot, "approach_only": approach_only}
@@ -201,10 +162,14 @@ def create_app(config: ServiceConfig) -> FastAPI:
             )
             return wire.json_response(_ik_single_json(result, residual))
         reference = inputs.reference(body, len(T))
-        arrays = await _ik_batch(runs(), config, T, reference, only_approach)
+        arrays = await _ik_batch(runs(), config, T, reference, only_approach, verify)
         if wire.wants_binary(request):
-            return wire.npz_response(arrays, {"count": len(T)})
-        return wire.json_response({"count": len(T), **arrays})
+            response = wire.arrays_response(request, arrays, {"count": len(T)})
+        else:
+            response = wire.json_response({"count": len(T), **arrays})
+        # Server time from the first body byte to the encoded answer (RFC Server-Timing).
+        response.headers["Server-Timing"] = f"app;dur={1e3 * (time.perf_counter() - start):.3f}"
+        return response
 
     # -- collision and trajectories ----------------------------------------
     @app.post("/check", tags=["collision"], openapi_extra=openapi_body("CheckRequest"))
@@ -215,11 +180,7 @@ def create_app(config: ServiceConfig) -> FastAPI:
         t = None if body.get("t") is None else wire.as_array(body["t"], "t", (), batch=True)
         if t is not None and t.shape != (len(q.reshape(-1, 5)),):
             raise Problem(422, f"t must have shape ({len(q.reshape(-1, 5))},). Got: {t.shape}", "t")
-        specs = inputs.obstacle_specs(body)
-        try:
-            obstacles = compute.build_obstacles(specs)
-        except (KeyError, TypeError) as exc:
-            raise Problem(422, f"obstacle: {str(exc).strip(chr(39))}", "obstacles") from None
+        obstacles = _obstacles(body)
         self_collision = inputs.flag(body, "self_collision")
         result = await asyncio.to_thread(compute.check_arrays, arm, q, t, obstacles, self_collision)
         return wire.json_response(result)
@@ -247,6 +208,38 @@ def create_app(config: ServiceConfig) -> FastAPI:
                 "segments": [p._asdict() for p in profiles],
             }
         )
+
+    @app.post("/plan", tags=["planning"], openapi_extra=openapi_body("PlanRequest"))
+    async def plan(request: Request) -> Response:
+        body = await json_body(request)
+        arm = get_robot(inputs.robot_name(body))
+        start = wire.as_array(body.get("start"), "start", (5,), batch=False)
+        goal_value = body.get("goal")
+        goal_shape = (4, 4) if isinstance(goal_value, list) and goal_value and isinstance(
+            goal_value[0], list) else (5,)  # fmt: skip
+        goal = wire.as_array(goal_value, "goal", goal_shape, batch=False)
+        obstacles = _obstacles(body)
+        seed = int(inputs.number(body, "seed", 0, 0, 2**31 - 1))
+        budget = inputs.number(body, "time_limit", 1.0, 1e-3, compute.MAX_PLAN_TIME)
+        options = body.get("options") or {}
+        if not isinstance(options, dict):
+            raise Problem(422, "options must be an object", "options")
+        try:
+            result = await asyncio.to_thread(
+                compute.plan_json, arm, start, goal, obstacles, seed, budget, options
+            )
+        except TypeError as exc:  # an unknown option name
+            raise Problem(422, f"options: {exc}".split(".__init__()")[-1], "options") from None
+        return wire.json_response(result)
+
+    @app.post("/view", tags=["kinematics"], openapi_extra=openapi_body("FkRequest"))
+    async def view(request: Request) -> Response:
+        body = await json_body(request)
+        arm = get_robot(inputs.robot_name(body))
+        q = wire.as_array(body.get("q"), "q", (5,), batch=False)
+        async with view_lock:  # one meshcat server process at a time
+            html = await asyncio.to_thread(compute.view_html, arm, q)
+        return HTMLResponse(html)
 
     # -- runs ----------------------------------------
     @app.post("/runs", status_code=202, tags=["runs"], openapi_extra=openapi_body("Scenario"))
@@ -281,8 +274,21 @@ def create_app(config: ServiceConfig) -> FastAPI:
         )
 
     @app.get("/runs/{run_id}", tags=["runs"])
-    async def get_run(run_id: str) -> Response:
-        return wire.json_response(_record(runs(), run_id).as_json())
+    async def get_run(
+        run_id: str,
+        wait: float = Query(
+            0.0,
+            ge=0.0,
+            le=60.0,
+            description="Long poll: wait up to this many seconds for the run to end, in s.",
+        ),
+    ) -> Response:
+        record = _record(runs(), run_id)
+        deadline = time.monotonic() + wait
+        while record.state not in FINAL_STATES and time.monotonic() < deadline:
+            await asyncio.sleep(RUN_POLL)
+            record = _record(runs(), run_id)
+        return wire.json_response(record.as_json())
 
     @app.delete("/runs/{run_id}", tags=["runs"])
     async def cancel_run(run_id: str) -> Response:
@@ -307,6 +313,10 @@ def create_app(config: ServiceConfig) -> FastAPI:
     async def page() -> Response:
         return HTMLResponse(_static("index.html").decode())
 
+    @app.get("/docs", include_in_schema=False)
+    async def docs() -> Response:
+        return HTMLResponse(_static("docs.html").decode())
+
     @app.get("/static/{name}", include_in_schema=False)
     async def static(name: str) -> Response:
         if "/" in name or name.startswith(".") or not _static_exists(name):
@@ -314,7 +324,25 @@ def create_app(config: ServiceConfig) -> FastAPI:
         media = mimetypes.guess_type(name)[0] or "application/octet-stream"
         return Response(_static(name), media_type=media)
 
+    _fast_routes(app, FAST_PATHS)
     return app
+
+
+def _fast_routes(app: FastAPI, paths: tuple[str, ...]) -> None:
+    """Serve ``paths`` by plain Starlette routes placed first (the FastAPI routes stay, for the
+    OpenAPI document only): FastAPI's route matching and dependency solving cost more than the
+    whole IK of one pose. Their endpoints take the request only and decode it themselves."""
+    from fastapi.routing import APIRoute
+    from starlette.routing import Route
+
+    fast = [
+        Route(
+            route.path, route.endpoint, methods=sorted(route.methods or ()), include_in_schema=False
+        )
+        for route in app.router.routes
+        if isinstance(route, APIRoute) and route.path in paths
+    ]
+    app.router.routes[:0] = fast
 
 
 def _static(name: str) -> bytes:
@@ -332,17 +360,25 @@ async def _maybe_threaded(count: int, function: Any, *args: Any) -> Any:
 
 
 async def _ik_batch(
-    manager: RunManager, config: ServiceConfig, T: np.ndarray, reference: Any, approach: bool
+    manager: RunManager,
+    config: ServiceConfig,
+    T: np.ndarray,
+    reference: Any,
+    approach: bool,
+    verify: bool,
 ) -> dict[str, np.ndarray]:
     from lynxplan.service.jobs import DaskPool
 
     if isinstance(manager.pool, DaskPool) and len(T) >= config.dask_batch:
         future = manager.pool.client.submit(
-            compute.ik_batch_arrays, T, reference, approach, pure=False
+            compute.ik_batch_arrays, T, reference, approach, verify, pure=False
         )
         result: dict[str, np.ndarray] = await asyncio.to_thread(future.result)
         return result
-    return await _maybe_threaded(len(T), compute.ik_batch_arrays, T, reference, approach)  # type: ignore[no-any-return]
+    arrays: dict[str, np.ndarray] = await _maybe_threaded(
+        len(T), compute.ik_batch_arrays, T, reference, approach, verify
+    )
+    return arrays
 
 
 def _ik_single_json(result: Any, residual: float) -> dict[str, Any]:
@@ -367,6 +403,13 @@ def _timing(body: dict[str, Any]) -> tuple[float, float] | None:
         inputs.number(timing, "tt", 0.0, 1e-6, 3600.0),
         inputs.number(timing, "ta", 0.0, 1e-9, 1800.0),
     )
+
+
+def _obstacles(body: dict[str, Any]) -> list[Any]:
+    try:
+        return compute.build_obstacles(inputs.obstacle_specs(body))
+    except (KeyError, TypeError) as exc:
+        raise Problem(422, f"obstacle: {str(exc).strip(chr(39))}", "obstacles") from None
 
 
 def _record(manager: RunManager, run_id: str) -> Any:

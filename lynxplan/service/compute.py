@@ -6,6 +6,7 @@ They are plain functions of arrays so that a Dask worker can run them too
 
 from __future__ import annotations
 
+import itertools
 from collections.abc import Mapping, Sequence
 from typing import Any
 
@@ -42,34 +43,39 @@ def ik_single(
 
     Returns:
         The library's ``IkResult`` and ``|p_fk(q) - p_target|`` of the selected solution, in [m]
-        (NaN when no branch is within limits).
+        (the library checks every branch by forward kinematics; NaN when no branch is within
+        limits).
     """
     result = arm.ik(T, q_reference=q_reference, select=select, approach_only=approach_only)
     if result.selected is None:
         return result, float("nan")
-    reached = arm.fk(result.solutions[result.selected].q)
-    return result, float(np.linalg.norm(reached[:3, 3] - T[:3, 3]))
+    return result, float(result.solutions[result.selected].position_error)
 
 
 def ik_batch_arrays(
-    T: np.ndarray, q_reference: np.ndarray | None = None, approach_only: bool = False
+    T: np.ndarray,
+    q_reference: np.ndarray | None = None,
+    approach_only: bool = False,
+    verify: bool = True,
 ) -> dict[str, np.ndarray]:
     """All-branch IK of (N, 4, 4) poses with each branch's FK position residual.
 
     Returns:
-        The fields of the library's ``IkBatch`` plus ``position_error`` (N, 4), in [m]:
-        ``|p_fk(q) - p_target|`` of every branch (NaN where the pose failed).
+        The fields of the library's ``IkBatch`` plus, when ``verify``, ``position_error``
+        (N, 4), in [m]: ``|p_fk(q) - p_target|`` of every branch (NaN where the pose failed).
     """
     from lynxplan.arm.model import load_arm
 
     arm = load_arm()
     batch = arm.ik_batch(T, q_reference=q_reference, approach_only=approach_only)
-    q = batch.q.reshape(-1, 5)
-    failed = ~np.isfinite(q).all(axis=1)
-    reached = arm.fk(np.where(failed[:, None], 0.0, q))[:, :3, 3].reshape(-1, 4, 3)
-    error = np.linalg.norm(reached - T.reshape(-1, 4, 4)[:, None, :3, 3], axis=2)
-    error[failed.reshape(-1, 4)] = np.nan
     out = {name: np.asarray(getattr(batch, name)) for name in batch._fields}
+    if not verify:
+        return out
+    q = np.nan_to_num(batch.q.reshape(-1, 5), nan=0.0)  # failed poses: NaN q, error set below
+    reached = arm.fk(q)[:, :3, 3].reshape(-1, 4, 3)
+    reached -= T.reshape(-1, 4, 4)[:, None, :3, 3]
+    error = np.sqrt(np.einsum("nbi,nbi->nb", reached, reached))
+    error[np.isnan(batch.q[..., 0])] = np.nan
     out["position_error"] = error
     return out
 
@@ -167,7 +173,7 @@ def trajectory_profiles(
     from lynxplan.trajectory.retime import lspb_profile
 
     profiles = []
-    for a, b in zip(waypoints[:-1], waypoints[1:], strict=True):
+    for a, b in itertools.pairwise(waypoints):
         fixed = LspbTiming(*timing) if timing is not None and method == "lspb" else None
         segment = free_segment(a, b, fixed, limits=limits)
         if method == "lspb":
@@ -177,3 +183,51 @@ def trajectory_profiles(
         else:
             profiles.append(toppra_profile(segment, limits, rate))
     return profiles
+
+
+def view_html(arm: Any, q: np.ndarray) -> str:
+    """A self-contained meshcat HTML page of the arm at ``q`` (5,) [rad]
+    (:func:`lynxplan.viz.export_html`; no network needed to display it)."""
+    import tempfile
+    from pathlib import Path
+
+    from lynxplan.viz import export_html
+
+    with tempfile.TemporaryDirectory(prefix="lynxplan-view-") as folder:
+        path = export_html(
+            arm, q.reshape(1, 5), np.zeros(1), Path(folder) / "view.html", autoplay=False
+        )
+        return path.read_text(encoding="utf-8")
+
+
+#: Largest planning time budget one /plan request may ask for, in [s].
+MAX_PLAN_TIME = 30.0
+
+
+def plan_json(
+    arm: Any,
+    start: np.ndarray,
+    goal: np.ndarray,
+    obstacles: list[Any],
+    seed: int,
+    time_limit: float,
+    options: dict[str, Any],
+) -> dict[str, Any]:
+    """:func:`lynxplan.planning.plan` from ``start`` (5,) [rad] to ``goal`` ((5,) joints or
+    (4, 4) tool pose [m]); the trajectory's fields as a JSON-ready mapping."""
+    import dataclasses
+
+    from lynxplan.planning import PlannerOptions, plan
+
+    result = plan(arm, obstacles, start, goal, seed=seed, time_limit=time_limit,
+                  options=PlannerOptions(**options))  # fmt: skip
+    fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
+    verification = dataclasses.asdict(result.verification)
+    verification["min_clearance"] = result.verification.min_clearance._asdict()
+    fields.update(
+        verification=verification,
+        stats=dataclasses.asdict(result.stats),
+        options=dataclasses.asdict(result.options),
+        duration=result.duration,
+    )
+    return fields

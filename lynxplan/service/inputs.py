@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,18 @@ def flag(body: dict[str, Any], name: str, default: bool = False) -> bool:
     if not isinstance(value, bool):
         raise Problem(422, f"{name} must be true or false. Got: {value!r}"[:120], name)
     return value
+
+
+def query_flag(params: Mapping[str, str], name: str, default: bool) -> bool:
+    """A boolean query parameter (``true``/``false``/``1``/``0``)."""
+    value = params.get(name)
+    if value is None:
+        return default
+    if value.lower() in ("true", "1", "yes"):
+        return True
+    if value.lower() in ("false", "0", "no"):
+        return False
+    raise Problem(422, f"{name} must be true or false. Got: {value!r}"[:120], name)
 
 
 def choice(body: dict[str, Any], name: str, options: tuple[str, ...]) -> str:

@@ -218,48 +218,25 @@ def execute_run(scenario_path: str, out_dir: str, quick: bool) -> dict[str, Any]
         return {"error": str(exc).splitlines()[0] if str(exc) else type(exc).__name__}
     except MemoryError:
         return {"error": "the run exceeded the worker's memory limit"}
-    except Exception as exc:  # noqa: BLE001 (a run must never take the worker down)
+    except Exception as exc:
         return {"error": f"internal error: {type(exc).__name__}: {exc}".splitlines()[0]}
     out = Path(out_dir)
     report_path = out / "report.json"
     report = json.loads(report_path.read_text()) if report_path.is_file() else None
-    failures = getattr(result, "failed_expectations", None)
-    if failures is None:  # the scenarios contract's Result: expectations with an ok flag
-        failures = [str(e) for e in getattr(result, "expectations", ()) if not _expectation_ok(e)]
     return {
         "ok": bool(result.ok),
         "summary": str(result.summary),
-        "failures": list(map(str, failures)),
+        "failures": list(result.failed_expectations),
         "report": report,
-        "artifacts": sorted(str(p.relative_to(out)) for p in out.rglob("*") if p.is_file()),
+        "artifacts": sorted(result.artifacts),
         "seconds": time.perf_counter() - start,
     }
 
 
-def _expectation_ok(expectation: Any) -> bool:
-    ok = getattr(expectation, "ok", None)
-    if ok is None and isinstance(expectation, dict):
-        ok = expectation.get("ok", True)
-    return bool(True if ok is None else ok)
-
-
-def _scenarios_api() -> Any:
-    """The scenarios contract package if present, else the older runner (same call shape)."""
-    import importlib
-
-    try:
-        return importlib.import_module("lynxplan.scenarios")
-    except ImportError:
-        return None
-
-
 def _run_scenario(scenario_path: str, out_dir: str, quick: bool) -> Any:
-    api = _scenarios_api()
-    if api is None:
-        from lynxplan.runner import run_scenario as run_old
+    from lynxplan.scenarios import run_scenario
 
-        return run_old(scenario_path, out_dir, quick=quick)
-    return api.run_scenario(scenario_path, out_dir, quick=quick)
+    return run_scenario(scenario_path, out_dir, quick=quick, force=True)
 
 
 def execute_run_packed(source: str, quick: bool) -> dict[str, Any]:
@@ -278,21 +255,26 @@ def execute_run_packed(source: str, quick: bool) -> dict[str, Any]:
 def validate_scenario(source: str) -> tuple[str, str]:
     """Validate scenario text (YAML or JSON) without running it; its (kind, name).
 
+    A scenario sent over the network may not name files on the server: a ``robot.urdf`` path
+    is refused (built-in robot names only).
+
     Raises:
         lynxplan.exceptions.ScenarioError: naming the key path and the reason.
     """
+    from lynxplan.exceptions import ScenarioError
+    from lynxplan.scenarios import load_scenario
+
     with tempfile.TemporaryDirectory(prefix="lynxplan-check-") as folder:
         path = Path(folder) / "scenario.yaml"
         path.write_text(source, encoding="utf-8")
-        api = _scenarios_api()
-        scenario: Any
-        if api is None:
-            from lynxplan.scenario import load_scenario
-
-            _, scenario = load_scenario(path)
-        else:
-            loaded = api.load_scenario(path)
-            scenario = getattr(loaded, "model", loaded[1] if isinstance(loaded, tuple) else loaded)
+        scenario = load_scenario(path).scenario
+    if getattr(getattr(scenario, "robot", None), "urdf", None) is not None:
+        raise ScenarioError(
+            "<request>",
+            "robot.urdf",
+            "the service runs built-in robots only "
+            "(robot: {name: ...}); it does not read URDF paths on its disk",
+        )
     return str(getattr(scenario, "kind", "")), str(getattr(scenario, "name", "") or "")
 
 
@@ -304,10 +286,7 @@ def _worker_main(connection: Any, memory_limit: int) -> None:
         import resource
 
         resource.setrlimit(resource.RLIMIT_AS, (memory_limit, memory_limit))
-    import lynxplan.runner  # noqa: F401 (warm imports before the first run)
-    from lynxplan.arm.model import load_arm
-
-    load_arm()
+    _warm_up()
     connection.send("ready")
     while True:
         try:
@@ -315,6 +294,20 @@ def _worker_main(connection: Any, memory_limit: int) -> None:
         except (EOFError, OSError):
             return
         connection.send(execute_run(*message))
+
+
+def _warm_up() -> None:
+    """Import every scenario kind and load the arm before the first run (fast first runs)."""
+    import importlib
+
+    from lynxplan.arm.model import load_arm
+    from lynxplan.scenarios.registry import KIND_MODULES
+
+    importlib.import_module("lynxplan.scenarios.runner")
+    for module in KIND_MODULES.values():
+        with contextlib.suppress(ImportError):
+            importlib.import_module(module)
+    load_arm()
 
 
 def _die_with_parent() -> None:
@@ -363,7 +356,11 @@ class _WorkerSlot:
         process.start()
         child.close()
         self._process, self._connection = process, parent
-        if not parent.poll(120) or parent.recv() != "ready":
+        try:
+            ready = parent.poll(120) and parent.recv() == "ready"
+        except (EOFError, OSError):
+            ready = False
+        if not ready:
             self.kill()
             raise RuntimeError("a run worker did not start")
 
@@ -465,7 +462,7 @@ class DaskPool:
             time.sleep(0.05)
         try:
             answer = future.result()
-        except Exception as exc:  # noqa: BLE001 (a lost worker, a cancelled task...)
+        except Exception as exc:
             answer = {"error": f"dask: {type(exc).__name__}: {exc}".splitlines()[0]}
         for name, content in answer.pop("files", {}).items():
             target = job.out_dir / name

@@ -51,6 +51,18 @@ class TrajectoryRequest(BaseModel):
     limits: dict[str, Any] | None = Field(None, description="{velocity, acceleration, jerk}.")
 
 
+class PlanRequest(BaseModel):
+    """Collision-free motion planning (RRT-Connect, shortcut, verified, time-parameterised)."""
+
+    robot: str = "al5"
+    start: list[float] = Field(description="Start joint angles (5,), in rad.")
+    goal: list[Any] = Field(description="Goal joints (5,) in rad, or tool pose (4, 4) in m.")
+    obstacles: list[dict[str, Any]] = Field(default_factory=list, description="As /check.")
+    seed: int = 0
+    time_limit: float = Field(1.0, description="Planning budget, in s (at most 30).")
+    options: dict[str, Any] | None = Field(None, description="PlannerOptions fields.")
+
+
 class Scenario(BaseModel):
     """A scenario file's content (``kind``, ``name``, ...), as YAML or JSON."""
 
@@ -60,7 +72,7 @@ class Scenario(BaseModel):
 
 _MODELS: dict[str, type[BaseModel]] = {
     model.__name__: model
-    for model in (FkRequest, IkRequest, CheckRequest, TrajectoryRequest, Scenario)
+    for model in (FkRequest, IkRequest, CheckRequest, TrajectoryRequest, PlanRequest, Scenario)
 }
 _BINARY = {"schema": {"type": "string", "format": "binary"}}
 
@@ -74,4 +86,12 @@ def openapi_body(name: str, *, binary: bool = False) -> dict[str, Any]:
         content["application/octet-stream"] = _BINARY
     if name == "Scenario":
         content["application/yaml"] = {"schema": {"type": "string"}}
-    return {"requestBody": {"required": True, "content": content}}
+    extra: dict[str, Any] = {"requestBody": {"required": True, "content": content}}
+    if binary:  # options of binary bodies travel in the query string
+        extra["parameters"] = [
+            {"name": "robot", "in": "query", "schema": {"type": "string", "default": "al5"}},
+            {"name": "approach_only", "in": "query", "schema": {"type": "boolean"}},
+            {"name": "verify", "in": "query", "schema": {"type": "boolean", "default": True},
+             "description": "/ik batches: FK position residual of every branch"},
+        ]  # fmt: skip
+    return extra

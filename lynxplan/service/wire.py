@@ -2,7 +2,9 @@
 
 Binary requests carry one array, either as ``application/x-npy`` (a ``.npy`` file, never pickled)
 or as ``application/octet-stream`` raw little-endian float64 with its shape in the ``X-Shape``
-header (``"100000,4,4"``). Binary responses are ``application/x-npz``: one ``.npy`` member per
+header (``"100000,4,4"``). Binary responses are ``application/x-npy-stream`` (the fastest: the
+``.npy`` files of the result arrays one after another, their names in the ``X-Arrays`` header,
+no checksum) or ``application/x-npz`` (a standard uncompressed archive): one ``.npy`` per
 result array. Arrays are checked for dtype, shape and finiteness with numpy, never element by
 element, and JSON answers serialise numpy arrays directly (``OPT_SERIALIZE_NUMPY``).
 """
@@ -23,6 +25,7 @@ from lynxplan.service.problems import Problem
 
 NPY_MEDIA_TYPE = "application/x-npy"
 NPZ_MEDIA_TYPE = "application/x-npz"
+STREAM_MEDIA_TYPE = "application/x-npy-stream"
 RAW_MEDIA_TYPE = "application/octet-stream"
 JSON_OPTIONS = orjson.OPT_SERIALIZE_NUMPY
 
@@ -54,8 +57,9 @@ def is_binary(request: Request) -> bool:
 
 
 def wants_binary(request: Request) -> bool:
-    """Whether the client asked for an npz answer (``Accept: application/x-npz``)."""
-    return NPZ_MEDIA_TYPE in request.headers.get("accept", "")
+    """Whether the client asked for a binary answer (npz or npy stream)."""
+    accept = request.headers.get("accept", "")
+    return NPZ_MEDIA_TYPE in accept or STREAM_MEDIA_TYPE in accept
 
 
 def parse_json_object(body: bytes) -> dict[str, Any]:
@@ -112,7 +116,7 @@ def as_array(
             array = np.array(value)
         except (ValueError, TypeError):
             raise Problem(422, f"{field} must be a (nested) list of numbers", field) from None
-    if array.dtype.kind not in "iuf" or array.size == 0 and array.ndim == 0:
+    if array.dtype.kind not in "iuf" or (array.size == 0 and array.ndim == 0):
         raise Problem(422, f"{field} must contain numbers only. Got: {_describe(value)}", field)
     expected = str(trailing) if not batch else f"{trailing} or (N, {', '.join(map(str, trailing))})"
     single = array.shape == trailing
@@ -167,13 +171,34 @@ def npz_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
     return buffer.getvalue()
 
 
-def npz_response(arrays: Mapping[str, np.ndarray], scalars: Mapping[str, Any]) -> Response:
-    """An npz answer; ``scalars`` travel as JSON in the ``X-Result`` header."""
-    return Response(
-        npz_bytes(arrays),
-        media_type=NPZ_MEDIA_TYPE,
-        headers={"X-Result": orjson.dumps(scalars).decode()},
-    )
+def npy_stream_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
+    """The ``.npy`` files of ``arrays`` one after another."""
+    buffer = io.BytesIO()
+    for array in arrays.values():
+        np.lib.format.write_array(buffer, np.ascontiguousarray(array), allow_pickle=False)
+    return buffer.getvalue()
+
+
+def arrays_response(
+    request: Request, arrays: Mapping[str, np.ndarray], scalars: Mapping[str, Any]
+) -> Response:
+    """A binary answer in the format the client accepts (npy stream, else npz); ``scalars``
+    travel as JSON in the ``X-Result`` header, the array names in ``X-Arrays``."""
+    stream = STREAM_MEDIA_TYPE in request.headers.get("accept", "")
+    content = npy_stream_bytes(arrays) if stream else npz_bytes(arrays)
+    headers = {"X-Result": orjson.dumps(scalars).decode(), "X-Arrays": ",".join(arrays)}
+    return Response(content, media_type=STREAM_MEDIA_TYPE if stream else NPZ_MEDIA_TYPE,
+                    headers=headers)  # fmt: skip
+
+
+def read_arrays(data: bytes, media: str, names: str) -> dict[str, np.ndarray]:
+    """Arrays of a binary answer (client side): npy stream (names from ``X-Arrays``) or npz."""
+    if media.startswith(STREAM_MEDIA_TYPE):
+        buffer = io.BytesIO(data)
+        return {
+            name: np.lib.format.read_array(buffer, allow_pickle=False) for name in names.split(",")
+        }
+    return read_npz(data)
 
 
 def read_npz(data: bytes) -> dict[str, np.ndarray]:

@@ -14,6 +14,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.arm.geometry import ArmGeometry, JointLimits
 from lynxplan.arm.kinematics import as_configurations
 from lynxplan.constants import RESOLVED_RATE_MAX_TIME_FACTOR
@@ -84,6 +85,9 @@ class TrParameters:
     def __post_init__(self) -> None:
         for name in ("m_bar", "sigma", "lambda_max", "lambda_min"):
             _require_positive(name, getattr(self, name))
+        # Damping outside this range leaves the 5x5 DLS system singular or meaningless.
+        for name in ("lambda_max", "lambda_min"):
+            _require_at_most(name, getattr(self, name), DAMPING_RANGE)
         _require_finite_non_negative("k_r", self.k_r)
         if self.m_dls is not None:
             _require_positive("m_dls", self.m_dls)
@@ -97,6 +101,15 @@ class TrParameters:
 def _require_positive(name: str, value: float) -> None:
     if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0.0):
         raise SingularityParameterError(name, value, "a finite number > 0")
+
+
+#: Valid DLS damping, in [m/rad]: below, J J^T + lambda^2 I is singular in floating point.
+DAMPING_RANGE = (1e-6, 10.0)
+
+
+def _require_at_most(name: str, value: float, bounds: tuple[float, float]) -> None:
+    if not bounds[0] <= value <= bounds[1]:
+        raise SingularityParameterError(name, value, f"within [{bounds[0]:g}, {bounds[1]:g}]")
 
 
 def _require_finite_non_negative(name: str, value: float) -> None:
@@ -127,6 +140,8 @@ class PathReference:
             raise ShapeError("points", "(M, 4) with M >= 2", points.shape)
         if not np.isfinite(points).all():
             raise InputError("path points contain NaN or infinite values")
+        guards.angles("path pitch", points[:, 3])
+        guards.length("path point coordinate", float(np.abs(points[:, :3]).max()))
         points.setflags(write=False)
         object.__setattr__(self, "points", points)
         _require_positive("duration", self.duration)
@@ -136,6 +151,11 @@ class PathReference:
                 "blend", self.blend, f"<= duration / 2 = {self.duration / 2.0:.6g} s"
             )
         _require_finite_non_negative("hold", self.hold)
+        for name in ("duration", "hold"):
+            if getattr(self, name) > guards.MAX_DURATION:
+                raise SingularityParameterError(
+                    name, getattr(self, name), f"<= {guards.MAX_DURATION:g} s"
+                )
 
     @classmethod
     def line(
@@ -232,6 +252,10 @@ class ResolvedRateProblem:
         object.__setattr__(self, "task", task)
         _require_positive("dt", self.dt)
         _require_finite_non_negative("gain", self.gain)
+        if self.gain * self.dt > 1.0:  # explicit Euler on the task error: stable for gain dt <= 1
+            raise SingularityParameterError(
+                "gain", self.gain, f"<= 1 / dt = {1.0 / self.dt:.6g} 1/s (gain * dt <= 1)"
+            )
         limits = np.array(self.velocity_limits, dtype=float)
         if limits.shape != (5,):
             raise ShapeError("velocity_limits", "(5,)", limits.shape)
@@ -244,6 +268,8 @@ class ResolvedRateProblem:
     def max_steps(self) -> int:
         """Step budget: the path time times the max time factor, plus the hold."""
         total = self.path.duration * RESOLVED_RATE_MAX_TIME_FACTOR + self.path.hold
+        steps = total / self.dt + 2.0
+        guards.check_size(f"resolved-rate steps (path time / dt = {self.dt:.3g} s)", steps, 160.0)
         return math.ceil(total / self.dt) + 2
 
     @property

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.exceptions import InputError
 from lynxplan.singularity.rate_kernel import (
     RateOutputs,
@@ -95,6 +96,8 @@ def run_resolved_rate(
     steps = problem.max_steps if max_steps is None else int(max_steps)
     if steps < 1:
         raise InputError(f"max_steps must be >= 1. Got: {steps}")
+    # Per step: t, m, q (5), qd (5), task error and reference (about 20 floats).
+    guards.check_size(f"resolved-rate steps (path time / dt = {problem.dt:.3g} s)", steps, 160.0)
     out = RateOutputs.empty(steps)
     g, path = problem.geometry, problem.path
     m_bar, sigma, k_r, lambda_min, lambda_max, m_dls = problem.parameters.as_array().tolist()

@@ -17,16 +17,13 @@ PATH_RATE = 100.0
 
 def write_html(scenario: Scenario, result: TaskResult, out_path: Path) -> Path:
     """Export the animated task (``lynxplan.viz.export_html``) to ``out_path``."""
-    from lynxplan.viz import export_html, tilted_plane
+    from lynxplan.viz import export_html
 
     samples, setup = result.samples, result.setup
-    step = max(1, int(round(scenario.sample_rate / PATH_RATE)))
+    step = max(1, round(scenario.sample_rate / PATH_RATE))
     index = np.unique(np.append(np.arange(0, len(samples.t), step), len(samples.t) - 1))
     kinds = [segment.kind for segment in setup.plan.segments]
-    plane = None
-    if setup.writing_plane is not None:
-        wp = setup.writing_plane
-        plane = tilted_plane(wp.point, float(np.degrees(wp.tilt)), (wp.size[0], wp.size[1]))
+    plane = setup.writing_plane
     return export_html(
         setup.arm,
         samples.q,

@@ -200,7 +200,7 @@ def plot_clearance(
     unit = scenario.units.length
     scale = length_factor(unit)
     samples = result.samples
-    step = max(1, int(round(scenario.sample_rate / CLEARANCE_PLOT_RATE)))
+    step = max(1, round(scenario.sample_rate / CLEARANCE_PLOT_RATE))
     index = np.unique(np.append(np.arange(0, len(samples.t), step), len(samples.t) - 1))
     profile = clearance_profile(result.world, samples.q[index])
     fig, ax = plt.subplots(figsize=(9, 4.5))

@@ -189,7 +189,7 @@ def task_details(scenario: Scenario, result: TaskResult) -> dict[str, Any]:
             "collision_geometries": [p.geometry for p in result.world.links],
         },
         "sample_rate_hz": scenario.sample_rate,
-        "sample_count": int(len(samples.t)),
+        "sample_count": len(samples.t),
         "obstacles": [_obstacle_entry(o) for o in setup.obstacles],
         "waypoints_rad": {name: q.tolist() for name, q in setup.waypoints.items()},
         "segments": _segment_entries(result),
@@ -225,7 +225,7 @@ def task_details(scenario: Scenario, result: TaskResult) -> dict[str, Any]:
             "engine": result.world.engine,
             "checked_pairs": int(result.world.pair_count),
             "self_collision": scenario.self_collision,
-            "samples": int(len(samples.t)),
+            "samples": len(samples.t),
             "certified_between_samples": collision.certified,
             "refined_intervals": collision.refined_intervals,
             "exact_queries": collision.exact_queries,
@@ -234,7 +234,8 @@ def task_details(scenario: Scenario, result: TaskResult) -> dict[str, Any]:
         "timing_comparison": _comparison(result),
         "stage_seconds": result.stage_seconds,
     }
-    return _clean(data)
+    cleaned: dict[str, Any] = _clean(data)
+    return cleaned
 
 
 def _clean(value: Any) -> Any:

@@ -8,13 +8,14 @@ schema error: file, key path (line), reason. This runs at run time, never during
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import LynxplanError, ScenarioValueError
 from lynxplan.units import angle_factor, length_factor
+from lynxplan.viz import WritingPlane
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm
@@ -29,27 +30,6 @@ if TYPE_CHECKING:
     )
     from lynxplan.trajectory.limits import MotionLimits
     from lynxplan.trajectory.plan import Plan
-
-
-@dataclass(frozen=True)
-class WritingPlane:
-    """The writing surface (drawn only).
-
-    Attributes:
-        point: A point of the plane, shape (3,), in [m].
-        tilt: Angle to the x-y plane, rising along +y, in [rad].
-        size: Extent along x and along the rising direction, shape (2,), in [m].
-    """
-
-    point: np.ndarray
-    tilt: float
-    size: np.ndarray
-
-    @property
-    def rotation(self) -> np.ndarray:
-        """Plane axes (columns: x, rising direction, normal), shape (3, 3)."""
-        c, s = np.cos(self.tilt), np.sin(self.tilt)
-        return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
 
 
 @dataclass(frozen=True)
@@ -102,15 +82,30 @@ def _resolve(scenario: Scenario) -> TaskSetup:
     path = route(scenario)
     q = waypoints[path[0][0]]
     segments = []
-    for i, ((_, target), entry) in enumerate(zip(path, scenario.segments, strict=True)):
+    expanded: list[tuple[str, str]] = []  # a planned motion adds its via points to the route
+    for i, ((start, target), entry) in enumerate(zip(path, scenario.segments, strict=True)):
+        if entry.motion == "plan":
+            vias = _planned_vias(i, entry, q, waypoints[target], arm, obstacles)
+            names = [start, *(f"{start}->{target}#{k}" for k in range(1, len(vias) - 1)), target]
+            waypoints.update(zip(names[1:-1], vias[1:-1], strict=True))
+            for k in range(len(vias) - 1):
+                piece = _segment(i, entry, vias[k + 1], vias[k], scenario, limits, "free")
+                segments.append(piece)
+                expanded.append((names[k], names[k + 1]))
+            q = segments[-1].q_end
+            continue
         segment = _segment(i, entry, waypoints[target], q, scenario, limits)
         segments.append(segment)
+        expanded.append((start, target))
         q = segment.q_end
+    path = tuple(expanded)
     plane = None
     if scenario.writing_plane is not None:
         wp = scenario.writing_plane
-        plane = WritingPlane(
-            np.array(wp.point) * length, float(wp.tilt) * angle, np.array(wp.size) * length
+        plane = WritingPlane.tilted(
+            np.array(wp.point) * length,
+            float(wp.tilt) * angle,
+            (wp.size[0] * length, wp.size[1] * length),
         )
     return TaskSetup(arm, obstacles, waypoints, path, limits, Plan(tuple(segments), limits), plane)
 
@@ -157,7 +152,8 @@ def rpy_matrix(rpy: np.ndarray) -> np.ndarray:
     rx = np.array([[1, 0, 0], [0, np.cos(r), -np.sin(r)], [0, np.sin(r), np.cos(r)]])
     ry = np.array([[np.cos(p), 0, np.sin(p)], [0, 1, 0], [-np.sin(p), 0, np.cos(p)]])
     rz = np.array([[np.cos(y), -np.sin(y), 0], [np.sin(y), np.cos(y), 0], [0, 0, 1]])
-    return rz @ ry @ rx
+    rotation: np.ndarray = rz @ ry @ rx
+    return rotation
 
 
 def _rotation(entry: BoxEntry | CylinderEntry, angle: float) -> np.ndarray | None:
@@ -288,6 +284,19 @@ def route(scenario: Scenario) -> tuple[tuple[str, str], ...]:
     return tuple(route)
 
 
+def _planned_vias(
+    i: int, entry: Any, q: np.ndarray, target: np.ndarray, arm: Arm, obstacles: Any
+) -> np.ndarray:
+    """``motion: plan``: the waypoints of a collision-free path planned by
+    :func:`lynxplan.plan` (RRT-Connect, shortcut, verified exactly), shape (M, 5), in [rad]."""
+    from lynxplan.planning import Planner
+
+    try:
+        return np.asarray(Planner(arm, obstacles).solve(q, target, seed=0).waypoints)
+    except LynxplanError as exc:
+        raise _InvalidError(("segments", i), f"planned motion to {entry.to!r}: {exc}") from exc
+
+
 def _segment(
     i: int,
     entry: Any,
@@ -295,13 +304,17 @@ def _segment(
     q: np.ndarray,
     scenario: Scenario,
     limits: MotionLimits,
+    motion: Literal["free", "line"] | None = None,
 ) -> Any:
     from lynxplan.trajectory.lspb import LspbTiming
     from lynxplan.trajectory.plan import SegmentSpec, build_plan
 
     timing_entry = entry.timing if entry.timing is not None else scenario.timing
     timing = None if timing_entry == "auto" else LspbTiming(timing_entry.tt, timing_entry.ta)
-    spec = SegmentSpec(entry.motion, target_q=target, timing=timing, mode=entry.orientation)
+    kind: Literal["free", "line"] = motion or entry.motion
+    if entry.motion == "plan":
+        timing = None  # the pieces of a planned motion: shortest LSPB each, rest at the vias
+    spec = SegmentSpec(kind, target_q=target, timing=timing, mode=entry.orientation)
     try:
         return build_plan(q, [spec], limits).segments[0]
     except LynxplanError as exc:

@@ -7,19 +7,30 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.arm.kinematics import as_configurations
-from lynxplan.exceptions import ShapeError
+from lynxplan.exceptions import InputError, ShapeError
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming, unit_lspb
 from lynxplan.trajectory.timing import auto_timing_linear
 
 
+def check_timing(timing: LspbTiming | None, name: str = "timing") -> None:
+    """A fixed timing must be an :class:`LspbTiming` within the documented duration range."""
+    if timing is None:
+        return
+    if not isinstance(timing, LspbTiming):
+        raise InputError(f"{name} must be an LspbTiming or None. Got: {type(timing).__name__}")
+    guards.duration(f"{name}.tt", timing.tt)
+
+
 def as_configuration(q: np.ndarray | list[float], name: str) -> np.ndarray:
-    """Validate one configuration: shape (5,), finite. Returns a read-only float copy."""
-    array = np.asarray(q, dtype=float)
+    """Validate one configuration: shape (5,), finite, ``|q| <= 100 rad`` (see
+    :mod:`lynxplan.guards`). Returns a read-only float copy."""
+    array = guards.float_array(name, q)
     if array.shape != (5,):
         raise ShapeError(name, "(5,)", array.shape)
-    out: np.ndarray = as_configurations(array, name)[0].copy()
+    out: np.ndarray = as_configurations(guards.angles(name, array), name)[0].copy()
     out.setflags(write=False)
     return out
 
@@ -102,6 +113,7 @@ def free_segment(
         limits: Velocity and acceleration limits for auto-timing (default: URDF + defaults).
     """
     qs, qe = as_configuration(q_start, "q_start"), as_configuration(q_end, "q_end")
+    check_timing(timing)
     if timing is None:
         lim = limits or MotionLimits()
         timing = auto_timing_linear(qe - qs, lim.velocity, lim.acceleration)

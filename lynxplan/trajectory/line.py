@@ -24,12 +24,13 @@ from typing import Literal
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.arm.geometry import ArmGeometry
-from lynxplan.arm.ik import as_poses, select_continuous, solve_ik_batch
+from lynxplan.arm.ik import select_continuous, solve_ik_batch
 from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import PATH_GRID_POINTS
 from lynxplan.exceptions import InputError, PathNotFollowableError
-from lynxplan.trajectory.free import JointSamples, as_configuration
+from lynxplan.trajectory.free import JointSamples, as_configuration, check_timing
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming, unit_lspb
 from lynxplan.trajectory.rotations import (
@@ -247,8 +248,10 @@ def line_segment(
             f"unknown orientation mode {mode!r}; valid modes: {', '.join(ORIENTATION_MODES)}"
         )
     lim = limits or MotionLimits()
-    T0, T1 = as_poses(T_start, "T_start")[0].copy(), as_poses(T_end, "T_end")[0].copy()
+    T0 = guards.poses("T_start", T_start, batch=False).copy()
+    T1 = guards.poses("T_end", T_end, batch=False).copy()
     qs = as_configuration(q_start, "q_start")
+    check_timing(timing)
     gap = float(np.linalg.norm(forward_kinematics(qs)[:3, 3] - T0[:3, 3]))
     if gap > 1e-6:
         raise InputError(f"T_start is {gap * 1000:.4g} mm from the tool point of q_start")

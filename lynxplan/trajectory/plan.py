@@ -14,11 +14,18 @@ from typing import Literal, NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.arm.ik import select_continuous, solve_ik_batch
 from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import InputError, PathNotFollowableError
-from lynxplan.trajectory.free import FreeSegment, JointSamples, as_configuration, free_segment
+from lynxplan.trajectory.free import (
+    FreeSegment,
+    JointSamples,
+    as_configuration,
+    check_timing,
+    free_segment,
+)
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.line import LineSegment, line_segment
 from lynxplan.trajectory.lspb import LspbTiming
@@ -98,8 +105,13 @@ class Plan:
         Args:
             rate: Samples per second, in [Hz] (the report used 10 Hz).
         """
-        if not (math.isfinite(rate) and rate > 0):
-            raise InputError(f"sample rate must be a positive number of Hz. Got: {rate}")
+        rate = guards.sample_rate("sample rate", rate)
+        # t, q, qd, qdd, tool pose, segment, branch, residual: about 300 bytes per sample.
+        guards.check_size(
+            f"trajectory samples ({self.duration:.6g} s at {rate:g} Hz)",
+            self.duration * rate + 2,
+            300.0,
+        )
         count = math.floor(self.duration * rate + 1e-9) + 1
         t = np.arange(count) / rate
         if t[-1] < self.duration - 1e-12:
@@ -124,7 +136,7 @@ class Plan:
 
 
 def _ik_nearest(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.ndarray:
-    ik = solve_ik_batch(np.asarray(T, dtype=float)[None], limits=limits.joint_limits)
+    ik = solve_ik_batch(T[None], limits=limits.joint_limits)
     if ik.status[0] != 0:
         raise PathNotFollowableError(1.0, float(ik.reach_miss[0]), "target pose")
     return np.asarray(select_continuous(ik.q, ik.within_limits, q_near)[0][0])
@@ -133,18 +145,23 @@ def _ik_nearest(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.n
 def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) -> Segment:
     if (spec.target_q is None) == (spec.target_pose is None):
         raise InputError(f"segment {i}: give exactly one of target_q and target_pose")
+    pose = np.eye(4)  # replaced below when the target is a pose
+    if spec.target_pose is not None:
+        pose = guards.poses(f"segments[{i}].target_pose", spec.target_pose, batch=False)
+    if spec.kind in ("free", "line"):
+        check_timing(spec.timing, f"segments[{i}].timing")
     if spec.kind == "free":
         target = (
             as_configuration(spec.target_q, f"segments[{i}].target_q")
             if spec.target_q is not None
-            else _ik_nearest(spec.target_pose, q, lim)  # type: ignore[arg-type]
+            else _ik_nearest(pose, q, lim)
         )
         return free_segment(q, target, spec.timing, limits=lim)
     if spec.kind == "line":
         T_end = (
             forward_kinematics(as_configuration(spec.target_q, f"segments[{i}].target_q"))
             if spec.target_q is not None
-            else np.asarray(spec.target_pose, dtype=float)
+            else pose
         )
         return line_segment(
             forward_kinematics(q), T_end, q, spec.timing, mode=spec.mode, limits=lim
@@ -169,8 +186,16 @@ def build_plan(
         PathNotFollowableError: a line leaves the reach, or a target pose is unreachable.
     """
     lim = limits or MotionLimits()
+    if not isinstance(lim, MotionLimits):
+        raise InputError(f"limits must be MotionLimits or None. Got: {type(lim).__name__}")
+    if isinstance(specs, (str, bytes)) or not hasattr(specs, "__len__"):
+        raise InputError(f"specs must be a list of SegmentSpec. Got: {type(specs).__name__}")
     if not specs:
         raise InputError("a plan needs at least one segment")
+    for i, spec in enumerate(specs):
+        if not isinstance(spec, SegmentSpec):
+            raise InputError(f"specs[{i}] must be a SegmentSpec. Got: {type(spec).__name__}")
+    guards.check_size("plan segments", len(specs))
     q = as_configuration(q_start, "q_start")
     segments: list[Segment] = []
     for i, spec in enumerate(specs):

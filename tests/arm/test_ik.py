@@ -14,6 +14,7 @@ from lynxplan.exceptions import (
     NoSolutionWithinLimitsError,
     NotRigidTransformError,
     OrientationNotReachableError,
+    OutOfRangeError,
     ShapeError,
     UnreachablePoseError,
 )
@@ -299,6 +300,9 @@ def test_bottom_row_error_is_named(arm) -> None:
 def test_huge_translation_is_out_of_reach_not_garbage(arm) -> None:
     T = arm.fk(np.zeros(5))
     T[0, 3] = 1e160
+    with pytest.raises(OutOfRangeError, match=r"T translation = 1e\+160 is out of range"):
+        arm.ik(T)  # beyond the documented range of positions (lynxplan.guards): bad input
+    T[0, 3] = 999.0
     with pytest.raises(UnreachablePoseError, match="out of reach"):
         arm.ik(T)
     assert solve_ik_batch(T).status[0] == IkStatus.OUT_OF_REACH

@@ -99,7 +99,11 @@ def test_ctrl_c_exits_130_with_one_line(tmp_path: Path) -> None:
         env=env,
         text=True,
     )
-    time.sleep(4.0)
+    deadline = time.monotonic() + 120.0  # interrupt once the run is under way (staging exists)
+    while not list(tmp_path.glob(".ws.staging-*")) and time.monotonic() < deadline:
+        assert process.poll() is None, process.communicate()
+        time.sleep(0.01)
+    time.sleep(0.2)
     process.send_signal(signal.SIGINT)
     _, err = process.communicate(timeout=60)
     assert process.returncode == 130, err

@@ -121,7 +121,7 @@ def test_workspace_json_and_png(capsys: pytest.CaptureFixture[str], tmp_path: Pa
             ["parallel", "fk", "-135", "-45", "90", "--near", "1", "2", "3"],
             "admit no assembly mode",
         ),
-        (["parallel", "workspace", "--alpha", "20", "--step", "0"], "step must be positive"),
+        (["parallel", "workspace", "--alpha", "20", "--step", "0"], "--step = 0 is out of range"),
         (["parallel", "workspace", "--alpha", "inf"], "--alpha: 'inf' is not a finite number"),
         (
             ["parallel", "workspace", "--alpha", "20", "--mode", "9"],

@@ -71,3 +71,20 @@ def test_edge_fraction_certifies_only_free_edges(arm: Arm, world: CollisionWorld
         certified += fraction == 1.0
         blocked += fraction < 1.0
     assert certified > 5 and blocked > 2
+
+
+def test_turning_the_base_joint_near_the_base_takes_few_steps(arm: Arm) -> None:
+    """The base cylinder is coaxial with q1: turning q1 cannot change any distance to it, so an
+    edge that only turns q1 with the upper arm 5 mm above the base is certified in one step of
+    the (upper arm, base) pair instead of hundreds."""
+    world = CollisionWorld(arm, [], self_collision=True)
+    checker = ValidityChecker(world, 0.002)
+    q_a = np.array([0.0, 0.0, -1.0, 1.5, 0.0])  # upper arm horizontal, 5 mm above the base
+    q_b = q_a + np.array([3.0, 0.0, 0.0, 0.0, 0.0])
+    assert min(world.distances(q_a)[0]) < 0.006
+    counters = checker.scratch[9]
+    counters[:] = 0
+    assert checker.edge_fraction(q_a, q_b) == 1.0
+    assert counters[1] < 40
+    s = np.linspace(0.0, 1.0, 50)
+    assert world.distances(q_a + s[:, None] * (q_b - q_a)).min() >= 0.002

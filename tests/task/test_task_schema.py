@@ -95,7 +95,7 @@ def _with_waypoint(name, entry):
         (_with_segment(1, to="K9"), r"segments\[1\]\.to", "unknown waypoint 'K9'; waypoints: K3"),
         (_with_segment(0, **{"from": "X"}), r"segments\[0\]\.from", "unknown waypoint 'X'"),
         (_with_segment(1, **{"from": "K3"}), r"segments\[1\]\.from", "ends at 'K4'"),
-        (_with_segment(1, motion="spline"), r"segments\[1\]\.motion", "'free' or 'line'"),
+        (_with_segment(1, motion="spline"), r"segments\[1\]\.motion", "'free', 'line' or 'plan'"),
         (_with_segment(1, tt=2), r"segments\[1\]\.tt", "Extra inputs"),
         (_with_segment(1, timing={"tt": 2.0}), r"segments\[1\]\.timing\.fixed\.ta", "required"),
         (_with_waypoint("K4", {"q": [0, 0, 0]}), r"waypoints\.K4\.q", "at least 5 items"),

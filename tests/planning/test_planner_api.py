@@ -1,0 +1,137 @@
+"""lynxplan.plan: determinism, errors for bad starts and goals, unsolvable problems, goals."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import lynxplan
+from lynxplan.arm import Arm
+from lynxplan.collision import BoxObstacle, CollisionWorld
+from lynxplan.exceptions import (
+    ConfigurationOutsideLimitsError,
+    GoalUnreachableError,
+    InputError,
+    PlanningFailed,
+    StateInCollisionError,
+)
+from lynxplan.planning import ApproachGoal, Planner, PlannerOptions, PoseGoal
+
+TABLE = BoxObstacle("table", [0.0, 0.1, -0.105], [0.9, 0.7, 0.03])
+WALL = BoxObstacle("wall", [0.0, 0.285, 0.18], [0.02, 0.33, 0.54])
+START = np.radians([45, 30, -30, 60, 0])
+GOAL = np.radians([135, 30, -30, 60, 0])
+
+
+@pytest.fixture(scope="module")
+def planner(arm: Arm) -> Planner:
+    return Planner(arm, [TABLE, WALL])
+
+
+def test_plan_is_exported_lazily_and_plans(arm: Arm) -> None:
+    trajectory = lynxplan.plan(arm, CollisionWorld(arm, [TABLE, WALL]), START, GOAL, seed=3)
+    assert isinstance(trajectory, lynxplan.PlannedTrajectory)
+    assert trajectory.verification.collision_free
+    assert trajectory.verification.self_collision_pairs > 0
+    assert trajectory.q.flags.writeable is False
+    with pytest.raises(ValueError, match="read-only"):
+        trajectory.q[0, 0] = 1.0
+
+
+def test_same_seed_gives_a_bit_identical_trajectory(planner: Planner) -> None:
+    first = planner.solve(START, GOAL, seed=7)
+    second = planner.solve(START, GOAL, seed=7)
+    for name in ("waypoints", "t", "q", "qd", "qdd"):
+        assert np.array_equal(getattr(first, name), getattr(second, name)), name
+    assert first.stats.nodes == second.stats.nodes
+
+
+def test_different_seeds_give_different_valid_paths(planner: Planner) -> None:
+    paths = [planner.solve(START, GOAL, seed=seed) for seed in range(4)]
+    assert all(p.verification.collision_free for p in paths)
+    assert len({p.waypoints.tobytes() for p in paths}) > 1
+
+
+def test_start_in_collision_names_link_obstacle_and_depth(planner: Planner) -> None:
+    inside = np.radians([90, 30, -30, 60, 0])  # the arm through the wall
+    with pytest.raises(
+        StateInCollisionError,
+        match=r"start is in collision: link \w+ with wall, "
+        r"penetration depth \d+\.\d+ mm",
+    ) as error:
+        planner.solve(inside, GOAL)
+    assert error.value.penetration_depth > 0.005
+    with pytest.raises(StateInCollisionError, match="goal is in collision"):
+        planner.solve(START, inside)
+
+
+def test_start_outside_the_limits_is_an_input_error(planner: Planner) -> None:
+    with pytest.raises(ConfigurationOutsideLimitsError, match=r"start: joint q3 = 0\.5 rad"):
+        planner.solve(np.array([0.5, 0.5, 0.5, 0.5, 0.5]), GOAL)
+
+
+def test_pose_goal_reaches_the_pose(arm: Arm, planner: Planner) -> None:
+    pose = arm.fk(GOAL)
+    trajectory = planner.solve(START, PoseGoal(pose), seed=1)
+    np.testing.assert_allclose(arm.fk(trajectory.q[-1]), pose, atol=1e-9)
+
+
+def test_approach_goal_reaches_position_and_direction(arm: Arm, planner: Planner) -> None:
+    goal = ApproachGoal([-0.2, 0.15, 0.0], [0.0, 0.0, -1.0])
+    trajectory = planner.solve(START, goal, seed=2)
+    tool = arm.fk(trajectory.q[-1])
+    np.testing.assert_allclose(tool[:3, 3], goal.position, atol=1e-9)
+    np.testing.assert_allclose(tool[:3, 2], goal.approach, atol=1e-9)
+
+
+def test_unreachable_pose_goal(planner: Planner) -> None:
+    far = np.eye(4)
+    far[:3, 3] = [0.0, 0.8, 0.0]
+    with pytest.raises(GoalUnreachableError, match="out of reach"):
+        planner.solve(START, PoseGoal(far))
+
+
+def test_node_budget_ends_the_search_with_the_count(arm: Arm) -> None:
+    planner = Planner(arm, [TABLE, WALL], PlannerOptions(max_nodes=5))
+    with pytest.raises(PlanningFailed, match=r"after \d+ nodes .*: node limit 5 reached"):
+        planner.solve(START, GOAL, seed=0)
+
+
+@pytest.mark.parametrize("timing", ["ruckig", "lspb", "toppra"])
+def test_every_timing_method_stays_on_the_path(planner: Planner, arm: Arm, timing: str) -> None:
+    timed = Planner(arm, [TABLE, WALL], PlannerOptions(timing=timing)).solve(START, GOAL, seed=5)
+    reference = planner.solve(START, GOAL, seed=5)
+    assert np.array_equal(timed.waypoints, reference.waypoints)
+    for k in range(len(timed.waypoints) - 1):
+        on = timed.segment == k
+        a, b = timed.waypoints[k], timed.waypoints[k + 1]
+        s = (timed.q[on] - a) @ (b - a) / ((b - a) @ (b - a))
+        np.testing.assert_allclose(timed.q[on], a + s[:, None] * (b - a), atol=1e-12)
+        assert (np.diff(s) >= -1e-12).all()
+
+
+def test_bad_options_are_input_errors() -> None:
+    with pytest.raises(InputError, match="timing must be one of"):
+        PlannerOptions(timing="spline")
+    with pytest.raises(InputError, match="step"):
+        PlannerOptions(step=0.0)
+
+
+def test_a_start_the_checker_cannot_certify_fails_at_once(arm: Arm) -> None:
+    """2.1 mm from a box face ahead of the pen (clear of the 2 mm clearance, so the exact check
+    accepts it) but within the checker's stall margin: PlanningFailed at once, naming the
+    obstacle, not after the time limit."""
+    pose = arm.fk(START)
+    approach = pose[:3, 2]
+    rotation = np.column_stack((pose[:3, 0], pose[:3, 1], approach))
+
+    def block(gap: float) -> BoxObstacle:
+        centre = pose[:3, 3] + (gap + 0.01) * approach
+        return BoxObstacle("block", centre, [0.04, 0.04, 0.02], rotation)
+
+    distance = CollisionWorld(arm, [block(0.05)]).distances(START)[0].min()
+    placed = block(0.05 - (distance - 0.0021))
+    exact = CollisionWorld(arm, [placed]).distances(START)[0].min()
+    assert 0.002 < exact < 0.0022
+    with pytest.raises(PlanningFailed, match=r"after 0 nodes .*start is too close to block"):
+        Planner(arm, [placed]).solve(START, GOAL, time_limit=30.0)
