@@ -109,7 +109,10 @@ def handle_ik(args: argparse.Namespace) -> int:
     if robots_cmd.wants_robot(args) or args.position is not None:
         return robots_cmd.handle_robot_ik(args)
     if args.pose is None:
-        raise InputError("ik: give --pose, or --position with --approach or --pitch")
+        raise InputError(
+            "ik: the following arguments are required: --pose"
+            " (or --position with --approach or --pitch)"
+        )
     units = _units(args)
     scale = angle_factor(units["angle"])
     pose = parse_pose(args.pose, units["length"])

@@ -195,7 +195,10 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
     elif args.pose is not None:
         result = robot.ik(parse_pose(args.pose, unit_length), q_reference=reference, verify=True)
     else:
-        raise InputError("ik: give --pose, or --position with --approach or --pitch")
+        raise InputError(
+            "ik: the following arguments are required: --pose"
+            " (or --position with --approach or --pitch)"
+        )
     listed = [i for i, s in enumerate(result.solutions) if args.all or s.within_limits]
     solutions = [
         {

@@ -88,4 +88,4 @@ def test_cli_errors(capsys: pytest.CaptureFixture[str]) -> None:
     assert main(["fk", "--robot", "so101", "0", "0"]) == 2
     assert "so101 has 5 joints; got 2" in capsys.readouterr().err
     assert main(["ik", "--json"]) == 2
-    assert "give --pose" in capsys.readouterr().err
+    assert "required: --pose (or --position" in capsys.readouterr().err
