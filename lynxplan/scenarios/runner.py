@@ -61,10 +61,37 @@ def validate(source: ScenarioSource) -> LoadedScenario:
     try:
         scenario = module.Input.model_validate(source.data)
     except ValidationError as exc:
-        first = exc.errors()[0]
+        first = _most_specific(exc.errors())
         message = first["msg"].removeprefix("Value error, ")
-        raise source.error(tuple(first["loc"]), message) from None
+        loc = _data_path(source.data, tuple(first["loc"]), first["type"] == "missing")
+        raise source.error(loc, message) from None
     return LoadedScenario(module, scenario, source.origin, source)
+
+
+def _most_specific(errors: list[Any]) -> Any:
+    """The error to show: for a value that matches no branch of a union (a number or a list),
+    the branch whose type matched says more ("at least 5 items") than "not a number"."""
+    for error in errors:
+        if not str(error["type"]).endswith(("_type", "_parsing")):
+            return error
+    return errors[0]
+
+
+def _data_path(data: Any, loc: tuple[Any, ...], missing: bool) -> tuple[int | str, ...]:
+    """``loc`` without pydantic's union and validator tags: only the keys and indices found in
+    the data (``limits.acceleration.list[...][1]`` -> ``limits.acceleration[1]``), plus the last
+    key when it is a missing required one."""
+    path: list[int | str] = []
+    node = data
+    for i, part in enumerate(loc):
+        if (isinstance(node, dict) and part in node) or (
+            isinstance(node, list) and isinstance(part, int) and 0 <= part < len(node)
+        ):
+            node = node[part]
+            path.append(part)
+        elif missing and i == len(loc) - 1:
+            path.append(part)
+    return tuple(path)
 
 
 def load_scenario(source: str | Path | Mapping[str, Any]) -> LoadedScenario:
