@@ -20,25 +20,33 @@ except PackageNotFoundError:  # a source tree on sys.path without an installed d
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm
     from lynxplan.planning.planner import PlannedTrajectory, plan
+    from lynxplan.robots import Robot, load_robot
     from lynxplan.scenarios.runner import run_scenario
 
 __all__ = [
     "Arm",
     "LynxplanError",
     "PlannedTrajectory",
+    "Robot",
     "__version__",
     "load_arm",
+    "load_robot",
     "plan",
     "run_scenario",
 ]
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy attributes: ``load_arm``, ``Arm``, ``run_scenario``, ``plan``, ``PlannedTrajectory``."""
+    """Lazy attributes: ``load_arm``, ``Arm``, ``load_robot``, ``Robot``, ``run_scenario``,
+    ``plan``, ``PlannedTrajectory``."""
     if name in ("load_arm", "Arm"):
         from lynxplan.arm import model
 
         return getattr(model, name)
+    if name in ("load_robot", "Robot"):
+        from lynxplan import robots
+
+        return getattr(robots, name)
     if name in ("plan", "PlannedTrajectory"):
         from lynxplan.planning import planner
 

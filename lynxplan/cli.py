@@ -56,6 +56,7 @@ COMMAND_MODULES = (
     "lynxplan.commands.parallel",
     "lynxplan.commands.scenario_tools",
     "lynxplan.commands.serve",
+    "lynxplan.commands.robots",
 )
 
 

@@ -482,3 +482,49 @@ class SingularityParameterError(InputError):
         self.value = value
         self.requirement = requirement
         super().__init__(f"singularity parameter {name} = {value!r} must be {requirement}")
+
+
+class RobotError(LynxplanError):
+    """A robot cannot be loaded or used as asked."""
+
+
+class UnknownRobotError(RobotError, InputError):
+    """A robot name that is neither a built-in robot nor an existing URDF file.
+
+    Attributes:
+        name: The name or path given.
+        valid: The built-in robot names.
+    """
+
+    def __init__(self, name: str, valid: tuple[str, ...]) -> None:
+        self.name = name
+        self.valid = valid
+        super().__init__(
+            f"unknown robot {name!r}: not a built-in robot ({', '.join(valid)}) nor a URDF file"
+        )
+
+
+class TargetError(RobotError, InputError):
+    """An IK target is malformed (wrong kind, zero approach vector, missing field).
+
+    Attributes:
+        reason: What is wrong.
+    """
+
+    def __init__(self, reason: str) -> None:
+        self.reason = reason
+        super().__init__(f"IK target: {reason}")
+
+
+class IkFailedError(RobotError, KinematicsError):
+    """No verified IK solution for a target (the numerical solver did not converge).
+
+    Attributes:
+        position_error: The smallest position error reached, in [m].
+    """
+
+    def __init__(self, position_error: float, detail: str = "") -> None:
+        self.position_error = position_error
+        super().__init__(
+            f"IK failed: best position error {position_error:.3g} m{'; ' + detail if detail else ''}"
+        )

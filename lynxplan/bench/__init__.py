@@ -22,6 +22,7 @@ SECTIONS: dict[str, str] = {
     "cold": "lynxplan.bench.cold",
     "plan": "lynxplan.bench.plan",
     "serve": "lynxplan.bench.serve",
+    "robots": "lynxplan.bench.robots",
 }
 
 

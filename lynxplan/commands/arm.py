@@ -12,6 +12,7 @@ from typing import Any
 import numpy as np
 
 from lynxplan import guards
+from lynxplan.commands import robots as robots_cmd
 from lynxplan.commands._output import parse_finite, parse_json_numbers, print_json
 from lynxplan.exceptions import InputError, ShapeError
 from lynxplan.units import LENGTH_UNITS, angle_factor, length_factor
@@ -24,10 +25,17 @@ def register(subparsers: Any) -> None:
         "q", nargs="*", metavar="Q", help="joint angles q1..q5 (rad, or deg with --deg)"
     )
     _add_unit_options(fk)
+    robots_cmd.add_robot_options(fk)
     fk.set_defaults(handler=handle_fk)
 
     ik = subparsers.add_parser("ik", help="inverse kinematics: tool pose -> joint angles")
-    ik.add_argument("--pose", required=True, help="tool pose as a JSON 4x4 (or 3x4) nested list")
+    ik.add_argument("--pose", help="tool pose as a JSON 4x4 (or 3x4) nested list")
+    ik.add_argument("--position", nargs=3, metavar=("X", "Y", "Z"), help="target tool point")
+    ik.add_argument(
+        "--approach", nargs=3, metavar=("AX", "AY", "AZ"), help="target approach direction"
+    )
+    ik.add_argument("--pitch", help="target approach pitch (from straight down, outwards)")
+    ik.add_argument("--roll", help="roll joint angle for --position targets (default: free)")
     ik.add_argument(
         "--all", action="store_true", help="list every branch, not only those in limits"
     )
@@ -43,6 +51,7 @@ def register(subparsers: Any) -> None:
     )
     ik.add_argument("--reference", help="reference configuration, JSON list of 5 angles")
     _add_unit_options(ik)
+    robots_cmd.add_robot_options(ik)
     ik.set_defaults(handler=handle_ik)
 
 
@@ -63,6 +72,8 @@ def handle_fk(args: argparse.Namespace) -> int:
     from lynxplan.arm import load_arm
     from lynxplan.arm.closed_form import tool_pose  # one pose: no numba import, fast start
 
+    if robots_cmd.wants_robot(args):
+        return robots_cmd.handle_robot_fk(args)
     units = _units(args)
     if len(args.q) != 5:
         raise InputError(f"fk: expected 5 joint angles q1..q5, got {len(args.q)}")
@@ -95,6 +106,13 @@ def handle_ik(args: argparse.Namespace) -> int:
     """Print every IK branch of a pose and the selected one."""
     from lynxplan.arm import load_arm
 
+    if robots_cmd.wants_robot(args) or args.position is not None:
+        return robots_cmd.handle_robot_ik(args)
+    if args.pose is None:
+        raise InputError(
+            "ik: the following arguments are required: --pose"
+            " (or --position with --approach or --pitch)"
+        )
     units = _units(args)
     scale = angle_factor(units["angle"])
     pose = parse_pose(args.pose, units["length"])

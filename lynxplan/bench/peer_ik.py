@@ -1,0 +1,101 @@
+"""Standalone peer-IK runner, executed by a peer's own virtual environment (never lynxplan's).
+
+    python peer_ik.py PEER URDF TOOL_FRAME POSES.npy OUT.json
+
+Solves each pose (N, 4, 4) from the zero configuration with the peer and writes
+``{"peer", "version", "success", "median_us", "count"}``. A solve succeeds when the reached tool
+pose is within 1e-6 m and 1e-5 rad of the target (checked with Pinocchio, or with the peer's own
+FK where Pinocchio is absent). Imports nothing from lynxplan: the peer venvs do not have it.
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+import time
+from importlib import metadata
+
+import numpy as np
+
+POSITION_TOLERANCE = 1e-6
+ORIENTATION_TOLERANCE = 1e-5
+
+
+def _angle(a: np.ndarray, b: np.ndarray) -> float:
+    m = a.T @ b
+    return float(np.arccos(np.clip(0.5 * (np.trace(m) - 1.0), -1.0, 1.0)))
+
+
+def _ok(reached: np.ndarray, target: np.ndarray) -> bool:
+    return (
+        float(np.linalg.norm(reached[:3, 3] - target[:3, 3])) <= POSITION_TOLERANCE
+        and _angle(reached[:3, :3], target[:3, :3]) <= ORIENTATION_TOLERANCE
+    )
+
+
+def run_pink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
+    import pink
+    import pinocchio as pin
+    from pink.tasks import FrameTask
+
+    model = pin.buildModelFromUrdf(urdf)
+    data = model.createData()
+    ok, times = [], []
+    for target in poses:
+        configuration = pink.Configuration(model, data, pin.neutral(model))
+        task = FrameTask(tool, position_cost=1.0, orientation_cost=1.0)
+        task.set_target(pin.SE3(target[:3, :3], target[:3, 3]))
+        start = time.perf_counter()
+        for _ in range(200):
+            velocity = pink.solve_ik(configuration, [task], 0.05, solver="daqp")
+            configuration.integrate_inplace(velocity, 0.05)
+            reached = configuration.get_transform_frame_to_world(tool).homogeneous
+            if _ok(reached, target):
+                break
+        times.append(time.perf_counter() - start)
+        ok.append(_ok(configuration.get_transform_frame_to_world(tool).homogeneous, target))
+    return ok, times
+
+
+def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
+    from ikpy.chain import Chain
+
+    chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=["base_link"])
+    names = [link.name for link in chain.links]
+    mask = [link.joint_type != "fixed" for link in chain.links]
+    chain = Chain.from_urdf_file(urdf, base_elements=["base_link"], active_links_mask=mask)
+    ok, times = [], []
+    for target in poses:
+        start = time.perf_counter()
+        q = chain.inverse_kinematics(
+            target[:3, 3],
+            target[:3, :3],
+            orientation_mode="all",
+            initial_position=[0.0] * len(names),
+        )
+        times.append(time.perf_counter() - start)
+        ok.append(_ok(chain.forward_kinematics(q), target))
+    return ok, times
+
+
+def main() -> None:
+    peer, urdf, tool, poses_path, out = sys.argv[1:6]
+    poses = np.load(poses_path)
+    runner = {"pink": run_pink, "ikpy": run_ikpy}[peer]
+    ok, times = runner(urdf, tool, poses)
+    package = {"pink": "pin-pink", "ikpy": "ikpy"}[peer]
+    with open(out, "w") as handle:
+        json.dump(
+            {
+                "peer": peer,
+                "version": metadata.version(package),
+                "success": float(np.mean(ok)),
+                "median_us": float(np.median(times) * 1e6),
+                "count": len(ok),
+            },
+            handle,
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,1 @@
+"""IK solvers: closed form for the yaw-pitch-pitch-pitch-roll family, numerical otherwise."""

@@ -1,0 +1,248 @@
+"""Python side of the yaw-pitch-pitch-pitch-roll solver: packing, AL5 delegation, results."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from lynxplan.robots.ik import family_kernel as fk_
+from lynxplan.robots.results import RobotIkBatch
+
+if TYPE_CHECKING:
+    from lynxplan.robots.robot import Robot, Target
+
+_SIDES = ("front", "back")
+_ELBOWS = ("elbow-up", "elbow-down")
+
+
+def branch_names(slots: int) -> tuple[str, ...]:
+    """Names of the branch slots: side/elbow (4 slots) or side/roll-i/elbow (root search)."""
+    if slots == 4:
+        return tuple(f"{s}/{e}" for s in _SIDES for e in _ELBOWS)
+    return tuple(
+        f"{s}/roll-{r + 1}/{e}" for s in _SIDES for r in range(fk_.MAX_ROOTS) for e in _ELBOWS
+    )
+
+
+def needs_root_search(robot: Robot, target: Target) -> bool:
+    """Whether the roll is found by root search (off-axis tool, roll not given, not pitch)."""
+    family = robot.family
+    assert family is not None
+    return (
+        not family.tool_on_roll_axis
+        and target.kind != fk_.MODE_PITCH
+        and bool(np.isnan(target.roll).any())
+    )
+
+
+def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIkBatch:
+    """Every branch of each target (see ``family_kernel``)."""
+    from lynxplan.robots.robot import REACH_TOLERANCE
+
+    family = robot.family
+    assert family is not None
+    n = target.poses.shape[0]
+    slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
+    q = np.full((n, slots, 5), np.nan)
+    valid = np.zeros((n, slots), dtype=np.bool_)
+    within = np.zeros((n, slots), dtype=np.bool_)
+    perr = np.full((n, slots), np.nan)
+    oerr = np.full((n, slots), np.nan)
+    rest = np.ones(n, dtype=np.bool_)
+    if robot._arm is not None and target.kind != fk_.MODE_PITCH:
+        rest = ~_al5_fill(robot, target, reference, q, valid, within, perr, oerr)
+    if rest.all():
+        _kernel(robot, target, reference, q, valid, within, perr, oerr)
+    elif rest.any():
+        sub = type(target)(
+            np.ascontiguousarray(target.poses[rest]),
+            target.kind,
+            target.pitch[rest],
+            target.roll[rest],
+        )
+        ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[rest])
+        parts = [a[rest] for a in (q, valid, within, perr, oerr)]
+        _kernel(robot, sub, ref, *parts)
+        for whole, part in zip((q, valid, within, perr, oerr), parts, strict=True):
+            whole[rest] = part
+    rescue_near_axis(robot, target, q, valid, within, perr, oerr)
+    distance = np.where(valid, perr, np.inf).min(axis=1)
+    reachable = distance <= REACH_TOLERANCE
+    # a reachable target's solutions are the branches that reach it; the others are dropped
+    valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
+    for array in (q, valid, within, perr, oerr, reachable, distance):
+        array.setflags(write=False)
+    return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
+
+
+#: Targets this much closer to the yaw axis than the wrist's lateral offset plus the tool's
+#: off-axis distance are "near the axis" [m]: there the yaw is so sensitive that a model only
+#: close to the family (SO-101) can hide a root of the exact model from the ideal one.
+NEAR_AXIS_MARGIN = 0.01
+#: Besides the closed-form branches, the rescue starts from this many fixed random configurations.
+RESCUE_STARTS = 16
+RESCUE_SEED = 5
+#: Approach targets: the rescue starts from each branch with its roll moved by these [rad].
+ROLL_NUDGES = (-0.8, -0.4, -0.2, -0.1, 0.1, 0.2, 0.4, 0.8)
+
+
+def rescue_near_axis(
+    robot: Robot,
+    target: Target,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> None:
+    """Near-family models (off-axis tool): Levenberg-Marquardt on the exact chain adds the
+    branches the ideal model misses. Full poses near the yaw axis with no exact branch: from
+    each branch and fixed random starts. Approach targets with the roll free and no exact
+    branch: also from each branch with its roll nudged (near-double roots split differently).
+
+    The numerical solver accepts only answers that reach the pose to 1e-10 m and 1e-9 rad.
+    """
+    from lynxplan.robots.ik.numerical import numerical_ik_kernel
+
+    family = robot.family
+    assert family is not None
+    if family.exact or family.tool_on_roll_axis or target.kind == fk_.MODE_PITCH:
+        return
+    exact_count = np.count_nonzero(valid & (oerr <= 1e-9), axis=1)
+    lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
+    approach_only = target.kind == fk_.MODE_APPROACH
+    if approach_only:
+        # near-double roots of the approach equation split differently on the exact model:
+        # with no exact branch found, look next to the branches along the roll
+        # (also when no branch reaches the position: the polish failed on every one)
+        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
+        rows = np.flatnonzero(near_miss & np.isnan(target.roll) & (exact_count == 0))
+    else:
+        k = np.array(family.yaw_axis)
+        d = target.poses[:, :3, 3] - family.packed[0:3]
+        rho = np.linalg.norm(d - np.outer(d @ k, k), axis=1)
+        near = rho < abs(family.lateral_offset) + family.tool_offset[1] + NEAR_AXIS_MARGIN
+        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
+        rows = np.flatnonzero(near & near_miss & (exact_count == 0))
+    axis = np.array(family.approach_in_tool)
+    for row in rows:
+        branches = q[row][valid[row]]
+        if approach_only:
+            nudged = [branches + np.array([0, 0, 0, 0, s]) for s in ROLL_NUDGES]
+            extra = np.random.default_rng(RESCUE_SEED).uniform(
+                lower, upper, size=(RESCUE_STARTS, 5)
+            )
+            seeds = np.ascontiguousarray(np.vstack((*nudged, extra)))
+        else:
+            extra = np.random.default_rng(RESCUE_SEED).uniform(
+                lower, upper, size=(RESCUE_STARTS, 5)
+            )
+            seeds = np.ascontiguousarray(np.vstack((branches, extra)))
+        n = seeds.shape[0]
+        found = np.empty((n, 5))
+        ok = np.empty(n, dtype=np.bool_)
+        p_err, o_err = np.empty(n), np.empty(n)
+        iterations = np.empty(n, dtype=np.int64)
+        numerical_ik_kernel(
+            robot.chain.placements,
+            robot.chain.axes,
+            np.repeat(target.poses[row : row + 1], n, 0),
+            approach_only,
+            lower,
+            upper,
+            seeds,
+            np.empty((0, 5)),
+            found,
+            ok,
+            p_err,
+            o_err,
+            iterations,
+            axis,
+        )
+        for i in np.flatnonzero(ok):
+            taken = q[row][valid[row]]
+            if taken.size and np.abs(taken - found[i]).max(axis=1).min() < 1e-9:
+                continue
+            free = np.flatnonzero(~valid[row])
+            if free.size == 0:
+                break
+            slot = free[0]
+            q[row, slot], valid[row, slot], within[row, slot] = found[i], True, True
+            perr[row, slot], oerr[row, slot] = p_err[i], o_err[i]
+
+
+def _kernel(
+    robot: Robot,
+    target: Target,
+    reference: np.ndarray,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> None:
+    family = robot.family
+    assert family is not None
+    miss = np.empty(valid.shape)
+    fk_.family_ik_kernel(
+        family.packed,
+        robot.chain.placements,
+        robot.chain.axes,
+        target.poses,
+        target.kind,
+        target.pitch,
+        target.roll,
+        reference,
+        q,
+        valid,
+        within,
+        perr,
+        oerr,
+        miss,
+    )
+
+
+def _al5_fill(
+    robot: Robot,
+    target: Target,
+    reference: np.ndarray,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> np.ndarray:
+    """Targets the AL5 kernels of lynxplan.arm solve (same numbers as before); returns which."""
+    from lynxplan.arm.ik import IkStatus
+
+    ref = np.broadcast_to(reference, (target.poses.shape[0], 5)).copy()
+    given = ~np.isnan(target.roll)
+    ref[given, 4] = target.roll[given]
+    arm = robot._arm
+    batch = arm.ik_batch(
+        target.poses, q_reference=ref, approach_only=target.kind == fk_.MODE_APPROACH
+    )
+    ok: np.ndarray = np.asarray(np.asarray(batch.status) == IkStatus.OK)
+    if not ok.any():
+        return ok
+    valid[ok] = True
+    q_arm = np.asarray(batch.q)[ok]
+    poses = np.asarray(arm.fk(q_arm.reshape(-1, 5))).reshape(-1, 4, 4, 4)
+    goal = target.poses[ok]
+    q[ok] = q_arm
+    within[ok] = np.asarray(batch.within_limits)[ok]
+    perr[ok] = np.linalg.norm(poses[:, :, :3, 3] - goal[:, None, :3, 3], axis=2)
+    if target.kind == fk_.MODE_APPROACH:
+        cosine = np.einsum("nbi,ni->nb", poses[:, :, :3, 2], goal[:, :3, 2])
+        sine = np.linalg.norm(np.cross(poses[:, :, :3, 2], goal[:, None, :3, 2]), axis=2)
+        oerr[ok] = np.arctan2(sine, cosine)
+    else:
+        m = np.einsum("nji,nbjk->nbik", goal[:, :3, :3], poses[:, :, :3, :3])
+        trace = np.trace(m, axis1=2, axis2=3)
+        vee = np.stack(
+            (m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]),
+            axis=-1,
+        )
+        oerr[ok] = np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), 0.5 * (trace - 1.0))
+    return ok

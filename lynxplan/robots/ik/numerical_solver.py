@@ -1,0 +1,65 @@
+"""Python side of the numerical solver: starts, packing, results (one slot per target)."""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from lynxplan.robots.ik import numerical as num
+from lynxplan.robots.results import RobotIkBatch
+
+if TYPE_CHECKING:
+    from lynxplan.robots.robot import Robot, Target
+
+#: Seed of the deterministic multi-start configurations.
+START_SEED = 20240613
+
+
+def solve_numerical(
+    robot: Robot, target: Target, reference: np.ndarray, starts: int = num.DEFAULT_STARTS
+) -> RobotIkBatch:
+    """Levenberg-Marquardt multi-start IK of each target (position + orientation or approach)."""
+    from lynxplan.exceptions import TargetError
+
+    if target.kind == 2:
+        raise TargetError("pitch targets need a yaw-pitch-pitch-pitch-roll arm")
+    n = target.poses.shape[0]
+    lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
+    finite_lower = np.where(np.isfinite(lower), lower, -np.pi)
+    finite_upper = np.where(np.isfinite(upper), upper, np.pi)
+    rng = np.random.default_rng(START_SEED)
+    seeds = rng.uniform(finite_lower, finite_upper, size=(starts, robot.nq))
+    q = np.empty((n, robot.nq))
+    success = np.empty(n, dtype=np.bool_)
+    perr, oerr = np.empty(n), np.empty(n)
+    iterations = np.empty(n, dtype=np.int64)
+    num.numerical_ik_kernel(
+        robot.chain.placements,
+        robot.chain.axes,
+        target.poses,
+        target.kind == 1,
+        lower,
+        upper,
+        np.ascontiguousarray(reference, dtype=float),
+        seeds,
+        q,
+        success,
+        perr,
+        oerr,
+        iterations,
+        np.array([0.0, 0.0, 1.0]),
+    )
+    within = success.copy()
+    arrays = (
+        q[:, None, :],
+        success[:, None],
+        within[:, None],
+        perr[:, None],
+        oerr[:, None],
+        success,
+        np.where(success, perr, perr),
+    )
+    for array in arrays:
+        array.setflags(write=False)
+    return RobotIkBatch(*arrays, ("numerical",))

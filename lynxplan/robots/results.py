@@ -1,0 +1,167 @@
+"""Typed, read-only results of the robot IK solvers."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from lynxplan.exceptions import NoSolutionWithinLimitsError
+
+
+class RobotIkSolution(NamedTuple):
+    """One IK branch, verified by forward kinematics on the exact model.
+
+    Attributes:
+        q: Joint angles, shape (n,), in [rad] (read-only).
+        branch: Branch name, e.g. ``"front/elbow-up"`` or ``"back/elbow-down/roll-1"``.
+        within_limits: Whether q is within the joint limits (after snapping).
+        position_error: ``|p_fk(q) - p_target|``, in [m] (the miss when unreachable).
+        orientation_error: Angle to the target orientation (full pose) or between the target
+            and reached approach axes (approach, pitch targets), in [rad].
+    """
+
+    q: np.ndarray
+    branch: str
+    within_limits: bool
+    position_error: float
+    orientation_error: float
+
+
+@dataclass(frozen=True)
+class RobotIkResult:
+    """IK of one target: every branch found, each verified; one selected.
+
+    Attributes:
+        solutions: The branches (verified by FK), solver order.
+        selected: Index of the chosen one (within limits and reachable, nearest to the
+            reference), or None when no branch is within the limits.
+        reachable: Whether the target position is reached (position error within tolerance).
+        distance: Smallest position error over the branches, in [m] (0 up to rounding when
+            reachable): how far the nearest reachable solution is from the target.
+        orientation_residual: Orientation error of the selected (else best) branch, in [rad].
+        solver: ``"yaw-pitch3-roll closed form"``, ``"... + roll root search"``, ``"numerical"``.
+    """
+
+    solutions: tuple[RobotIkSolution, ...]
+    selected: int | None
+    reachable: bool
+    distance: float
+    orientation_residual: float
+    solver: str
+
+    @property
+    def q(self) -> np.ndarray:
+        """The selected solution, shape (n,), in [rad].
+
+        Raises:
+            NoSolutionWithinLimitsError: if no branch is within the joint limits.
+        """
+        if self.selected is None:
+            raise NoSolutionWithinLimitsError(
+                "IK: no branch is within the joint limits: "
+                + "; ".join(
+                    f"{s.branch} {np.degrees(s.q).round(3).tolist()} deg" for s in self.solutions
+                )
+            )
+        return self.solutions[self.selected].q
+
+
+class RobotIkBatch(NamedTuple):
+    """IK of N targets, every branch slot. Arrays are read-only; empty slots are NaN/False."""
+
+    q: np.ndarray
+    """Joint angles, shape (N, B, n), in [rad]; NaN in unused slots."""
+    valid: np.ndarray
+    """Whether a slot holds a verified branch, shape (N, B), bool."""
+    within_limits: np.ndarray
+    """Whether each branch is within the joint limits, shape (N, B), bool."""
+    position_error: np.ndarray
+    """FK position error of each branch, shape (N, B), in [m]."""
+    orientation_error: np.ndarray
+    """Orientation error of each branch, shape (N, B), in [rad] (see RobotIkSolution)."""
+    reachable: np.ndarray
+    """Whether some branch reaches the position, shape (N,), bool."""
+    distance: np.ndarray
+    """Smallest position error over the branches, shape (N,), in [m]."""
+    branch_names: tuple[str, ...]
+    """Name of each of the B slots."""
+
+
+@dataclass(frozen=True)
+class TrackJump:
+    """A step of a track where no branch continues the previous configuration.
+
+    Attributes:
+        index: Index of the target (the jump is from ``index - 1`` to ``index``).
+        size: Largest joint change of the step, in [rad].
+    """
+
+    index: int
+    size: float
+
+
+@dataclass(frozen=True)
+class TrackResult:
+    """IK along a sequence of targets, branch by branch continuity.
+
+    Attributes:
+        q: Joint angles, shape (N, n), in [rad]; NaN where no solution (read-only).
+        branch: Branch slot per target, shape (N,), -1 where none (read-only).
+        jumps: Steps larger than the continuity threshold: flagged, never silent.
+        unsolved: Indices of targets with no solution within limits.
+        max_step: Largest joint change between consecutive solved targets, in [rad].
+    """
+
+    q: np.ndarray
+    branch: np.ndarray
+    jumps: tuple[TrackJump, ...]
+    unsolved: tuple[int, ...]
+    max_step: float
+
+    @property
+    def continuous(self) -> bool:
+        """Whether every target is solved with no jump."""
+        return not self.jumps and not self.unsolved
+
+
+@dataclass(frozen=True)
+class JointInfo:
+    """One joint of the arm chain.
+
+    Attributes:
+        name: URDF joint name.
+        lower, upper: Position limits, in [rad].
+        velocity: Velocity limit, in [rad/s].
+    """
+
+    name: str
+    lower: float
+    upper: float
+    velocity: float
+
+
+@dataclass(frozen=True)
+class RobotInfo:
+    """What ``lynxplan robot info`` prints.
+
+    Attributes:
+        name: Robot name.
+        urdf: URDF path.
+        tool_frame: Tool frame name.
+        joints: The arm joints.
+        locked_joints: Joints off the chain (a gripper jaw), with the value they are held at.
+        family: ``"yaw-pitch-pitch-pitch-roll"`` or why not (the reason).
+        family_parameters: Parameters of the recognised family (``FamilyParameters``), or None.
+        ik_solver: The IK solver used.
+    """
+
+    name: str
+    urdf: str
+    tool_frame: str
+    joints: tuple[JointInfo, ...]
+    locked_joints: tuple[tuple[str, float], ...]
+    family: str
+    family_parameters: object | None
+    ik_solver: str

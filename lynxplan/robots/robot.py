@@ -1,0 +1,570 @@
+"""A robot arm loaded from URDF: one surface for every arm (FK, IK, Jacobian, tracking, limits).
+
+IK picks its solver from the geometry: the closed form (with a roll root search for an off-axis
+tool) when the chain is yaw-pitch-pitch-pitch-roll, the numerical solver otherwise. The AL5
+hands poses and approach targets to the existing :class:`lynxplan.arm.model.Arm` kernels, so its
+numbers are those of ``lynxplan.arm``.
+
+Targets: a full pose (4x4; for a 5-joint arm solved in the least-squares sense: the position
+exactly, the approach axis projected into the arm plane, the roll nearest), a position plus an
+approach direction (the roll free or given), or a position plus an approach pitch (the angle from
+straight down towards the outward direction of the arm plane; the AL5's q2 + q3 + q4).
+"""
+
+from __future__ import annotations
+
+from functools import cached_property
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lynxplan.arm.geometry import JointLimits
+from lynxplan.constants import LIMIT_SNAP_TOLERANCE
+from lynxplan.exceptions import NonFiniteInputError, ShapeError, TargetError
+from lynxplan.robots import chain as _chain
+from lynxplan.robots.family import FamilyParameters, recognise_family
+from lynxplan.robots.loading import BuiltinRobot, LoadedModel
+from lynxplan.robots.results import (
+    JointInfo,
+    RobotIkBatch,
+    RobotIkResult,
+    RobotIkSolution,
+    RobotInfo,
+    TrackJump,
+    TrackResult,
+)
+
+#: A branch reaches its target when FK puts the tool this close to the target position [m].
+REACH_TOLERANCE = 1e-9
+#: ik_track flags a step whose largest joint change exceeds this [rad].
+TRACK_JUMP_THRESHOLD = 0.5
+
+KIND_POSE, KIND_APPROACH, KIND_PITCH = 0, 1, 2
+_ZERO1 = np.zeros(1)
+_NAN1 = np.full(1, np.nan)
+
+
+class Target:
+    """IK targets in packed form (internal): poses (N, 4, 4), kind, pitch (N,), roll (N,)."""
+
+    def __init__(self, poses: np.ndarray, kind: int, pitch: np.ndarray, roll: np.ndarray) -> None:
+        self.poses, self.kind, self.pitch, self.roll = poses, kind, pitch, roll
+
+
+def _as_array(x: Any, name: str, shape_tail: tuple[int, ...]) -> np.ndarray:
+    array = np.asarray(x, dtype=float)
+    nd = len(shape_tail)
+    if array.shape[array.ndim - nd :] != shape_tail or array.ndim not in (nd, nd + 1):
+        expected = ", ".join(map(str, shape_tail))
+        raise ShapeError(name, f"({expected}) or (N, {expected})", array.shape)
+    if not np.isfinite(array).all():
+        raise NonFiniteInputError(name)
+    return array.reshape((-1, *shape_tail))
+
+
+def make_target(  # noqa: PLR0912 (one branch per target form)
+    poses: Any = None,
+    positions: Any = None,
+    approaches: Any = None,
+    pitches: Any = None,
+    rolls: Any = None,
+) -> Target:
+    """Pack one kind of target. Raises TargetError for a missing/contradictory combination."""
+    if poses is not None:
+        if positions is not None or approaches is not None or pitches is not None:
+            raise TargetError("give a pose, or a position with an approach or a pitch; not both")
+        array = _as_array(poses, "pose", (4, 4))
+        kind = KIND_POSE
+        n = array.shape[0]
+    else:
+        if positions is None:
+            raise TargetError("give a pose (4x4) or a position (x, y, z)")
+        pos = _as_array(positions, "position", (3,))
+        n = pos.shape[0]
+        array = np.tile(np.eye(4), (n, 1, 1))
+        array[:, :3, 3] = pos
+        if approaches is not None and pitches is not None:
+            raise TargetError("give an approach direction or a pitch, not both")
+        if approaches is not None:
+            app = _as_array(approaches, "approach", (3,))
+            norms = np.linalg.norm(app, axis=1)
+            if (norms < 1e-12).any():
+                raise TargetError("the approach direction must be a non-zero vector")
+            app = app / norms[:, None]
+            if app.shape[0] not in (1, n):
+                raise ShapeError("approach", f"(3,) or ({n}, 3)", app.shape)
+            array[:, :3, 2] = app
+            kind = KIND_APPROACH
+        elif pitches is not None:
+            kind = KIND_PITCH
+        else:
+            raise TargetError("a position needs an approach direction or a pitch")
+    pitch = np.zeros(n)
+    if pitches is not None:
+        p = np.asarray(pitches, dtype=float).reshape(-1)
+        if p.shape[0] not in (1, n) or not np.isfinite(p).all():
+            raise TargetError(f"pitch must be finite, one value or {n}")
+        pitch[:] = p
+    roll = np.full(n, np.nan)
+    if rolls is not None:
+        r = np.asarray(rolls, dtype=float).reshape(-1)
+        if r.shape[0] not in (1, n):
+            raise TargetError(f"roll must be one value or {n}")
+        roll[:] = r
+    return Target(np.ascontiguousarray(array), kind, pitch, roll)
+
+
+class Robot:
+    """A robot arm from URDF (see the module docstring).
+
+    Attributes:
+        name: Built-in name or URDF file name.
+        urdf_path: The URDF.
+        model: Pinocchio model of the arm chain (fixed base, locked joints removed).
+        data: Pinocchio data of ``model``.
+        tool_frame: Tool frame name; ``tool_frame_id`` its id.
+        locked_joints: Joints off the chain (gripper jaw), with the value they are held at.
+        limits: Joint position and velocity limits (``position`` (n, 2) [rad], ``velocity`` (n,)).
+        family: Recognised family parameters, or None (then IK is numerical).
+        family_reason: The family name, or why the chain is not in it.
+        nq: Number of joints.
+    """
+
+    def __init__(self, loaded: LoadedModel, builtin: BuiltinRobot | None = None) -> None:
+        self.name = loaded.name
+        self.urdf_path = Path(loaded.urdf)
+        self.model = loaded.model
+        self.data = self.model.createData()
+        self.tool_frame = loaded.tool_frame
+        self.tool_frame_id = loaded.tool_frame_id
+        self.locked_joints = loaded.locked_joints
+        self.package_dirs = loaded.package_dirs
+        self._urdf_xml = loaded.urdf_xml
+        self.builtin = builtin
+        self.nq = int(self.model.nq)
+        position = np.column_stack((self.model.lowerPositionLimit, self.model.upperPositionLimit))
+        velocity = np.array(self.model.velocityLimit, dtype=float)
+        position.setflags(write=False)
+        velocity.setflags(write=False)
+        self.limits = JointLimits(position=position, velocity=velocity)
+        self.joint_names = tuple(str(n) for n in list(self.model.names)[1:])
+        self.chain = _chain.chain_from_model(self.model, self.tool_frame_id)
+        family, reason = recognise_family(
+            self.model,
+            self.tool_frame_id,
+            self.limits.lower,
+            self.limits.upper,
+            LIMIT_SNAP_TOLERANCE,
+        )
+        self.family: FamilyParameters | None = family
+        self.family_reason = reason
+        self._zero_reference = np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
+        self._arm: Any = None
+        if builtin is not None and builtin.name == "al5":
+            from lynxplan.arm.model import load_arm
+
+            self._arm = load_arm()
+
+    # -- description ------------------------------------------------------------------------
+    @property
+    def ik_solver(self) -> str:
+        """Name of the IK solver this robot uses."""
+        if self.family is None:
+            return "numerical (Levenberg-Marquardt, multi-start)"
+        name = "yaw-pitch3-roll closed form"
+        if not self.family.tool_on_roll_axis:
+            name += " + roll root search (off-axis tool)"
+        if not self.family.exact:
+            name += f" + Newton polish (model off the family by {self.family.deviation:.2g} rad)"
+        if self._arm is not None:
+            name += "; poses and approach targets by lynxplan.arm (AL5 kernels)"
+        return name
+
+    def info(self) -> RobotInfo:
+        """Joints, limits, family and its parameters, IK solver."""
+        joints = tuple(
+            JointInfo(n, float(lo), float(hi), float(v))
+            for n, (lo, hi), v in zip(
+                self.joint_names, self.limits.position, self.limits.velocity, strict=True
+            )
+        )
+        return RobotInfo(
+            self.name,
+            str(self.urdf_path),
+            self.tool_frame,
+            joints,
+            self.locked_joints,
+            self.family_reason,
+            self.family,
+            self.ik_solver,
+        )
+
+    def __repr__(self) -> str:
+        return f"Robot({self.name!r}, tool={self.tool_frame!r}, nq={self.nq})"
+
+    # -- geometry models -----------------------------------------------------------------------
+    @cached_property
+    def collision_model(self) -> Any:
+        """Pinocchio GeometryModel of the URDF's collision elements (meshes via package_dirs)."""
+        import pinocchio as pin
+
+        return pin.buildGeomFromUrdfString(
+            self.model,
+            self._urdf_xml,
+            pin.GeometryType.COLLISION,
+            package_dirs=list(self._mesh_dirs()),
+        )
+
+    @cached_property
+    def visual_model(self) -> Any:
+        """Pinocchio GeometryModel of the URDF's visual elements."""
+        import pinocchio as pin
+
+        return pin.buildGeomFromUrdfString(
+            self.model,
+            self._urdf_xml,
+            pin.GeometryType.VISUAL,
+            package_dirs=list(self._mesh_dirs()),
+        )
+
+    def _mesh_dirs(self) -> tuple[str, ...]:
+        return (*self.package_dirs, str(self.urdf_path.parent))
+
+    # -- kinematics ----------------------------------------------------------------------------
+    def _configurations(self, q: Any, name: str = "q") -> np.ndarray:
+        return np.ascontiguousarray(_as_array(q, name, (self.nq,)))
+
+    def fk(self, q: Any) -> np.ndarray:
+        """Tool pose. q: shape (n,) or (N, n) in [rad] -> (4, 4) or (N, 4, 4), in [m]."""
+        configs = self._configurations(q)
+        if self._arm is not None:
+            out = np.asarray(self._arm.fk(configs))
+        else:
+            out = np.empty((configs.shape[0], 4, 4))
+            _chain.chain_fk_batch(self.chain.placements, self.chain.axes, configs, out)
+        return out[0] if np.ndim(q) == 1 else out
+
+    def jacobian(self, q: Any) -> np.ndarray:
+        """Geometric tool Jacobian, LOCAL_WORLD_ALIGNED (rows: linear [m/s], angular [rad/s]).
+
+        q: shape (n,) or (N, n) in [rad] -> (6, n) or (N, 6, n).
+        """
+        configs = self._configurations(q)
+        out = np.empty((configs.shape[0], 6, self.nq))
+        _chain.chain_jacobian_batch(self.chain.placements, self.chain.axes, configs, out)
+        return out[0] if np.ndim(q) == 1 else out
+
+    def frame_placement(self, q: Any, frame: str | None = None) -> np.ndarray:
+        """Pose of a frame computed by Pinocchio. q: shape (n,) [rad] -> (4, 4) [m]."""
+        import pinocchio as pin
+
+        from lynxplan.exceptions import ModelError
+
+        config = self._configurations(q)[0]
+        name = frame or self.tool_frame
+        if not self.model.existFrame(name):
+            raise ModelError(f"unknown frame {name!r}")
+        frame_id = self.tool_frame_id if frame is None else self.model.getFrameId(name)
+        pin.forwardKinematics(self.model, self.data, config)
+        return np.array(pin.updateFramePlacement(self.model, self.data, frame_id).homogeneous)
+
+    def approach(self, q: Any) -> np.ndarray:
+        """Approach axis (the roll axis, towards the tool; the tool z axis for non-family arms).
+
+        q: (n,) or (N, n) [rad] -> (3,) or (N, 3), unit vectors in the base frame.
+        """
+        poses = self.fk(q)
+        return np.asarray(poses[..., :3, :3] @ self.approach_in_tool)
+
+    @property
+    def approach_in_tool(self) -> np.ndarray:
+        """The approach axis in tool-frame coordinates, shape (3,)."""
+        if self.family is None:
+            return np.array([0.0, 0.0, 1.0])
+        return np.array(self.family.approach_in_tool)
+
+    # -- inverse kinematics --------------------------------------------------------------------
+    def _reference(self, q_reference: Any, n: int) -> np.ndarray:
+        if q_reference is None:
+            return np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
+        ref = np.ascontiguousarray(_as_array(q_reference, "q_reference", (self.nq,)))
+        if ref.shape[0] not in (1, n):
+            raise ShapeError("q_reference", f"({self.nq},) or ({n}, {self.nq})", ref.shape)
+        return ref
+
+    def ik_batch(
+        self,
+        poses: Any = None,
+        *,
+        positions: Any = None,
+        approaches: Any = None,
+        pitches: Any = None,
+        rolls: Any = None,
+        q_reference: Any = None,
+    ) -> RobotIkBatch:
+        """Every IK branch of N targets. Never raises for unreachable targets.
+
+        Args:
+            poses: Full target poses, shape (N, 4, 4), [m]; or
+            positions: Target tool points, shape (N, 3), [m], with
+            approaches: approach directions, shape (N, 3) (any length > 0), or
+            pitches: approach pitches, shape (N,), [rad] (from straight down, outwards).
+            rolls: Roll joint angle, shape (N,) or scalar, [rad]; NaN/None: free.
+            q_reference: (n,) or (N, n) [rad]: yaw on the base axis, roll when free and
+                undetermined, first start of the numerical solver.
+
+        Returns:
+            A :class:`RobotIkBatch`: unreachable targets get their nearest solution,
+            ``reachable`` False and the ``distance``.
+        """
+        target = make_target(poses, positions, approaches, pitches, rolls)
+        return self._solve(target, self._reference(q_reference, target.poses.shape[0]))
+
+    def _solve(self, target: Target, reference: np.ndarray) -> RobotIkBatch:
+        if self.family is None:
+            from lynxplan.robots.ik.numerical_solver import solve_numerical
+
+            return solve_numerical(self, target, reference)
+        from lynxplan.robots.ik.family_solver import solve_family
+
+        return solve_family(self, target, reference)
+
+    def ik(
+        self,
+        pose: Any = None,
+        *,
+        position: Any = None,
+        approach: Any = None,
+        pitch: float | None = None,
+        roll: float | None = None,
+        q_reference: Any = None,
+        verify: bool = False,
+        approach_only: bool = False,
+        select: str = "nearest",
+    ) -> RobotIkResult:
+        """IK of one target: every branch, verified, one selected (nearest the reference).
+
+        Args:
+            pose: Target tool pose, shape (4, 4), [m]; or ``position`` (3,) [m] with
+                ``approach`` (3,) or ``pitch`` [rad]; ``roll`` [rad] fixes the roll joint.
+            q_reference: Shape (n,), [rad]: configuration to stay near. Default: zeros.
+            approach_only: ``lynxplan.arm.Arm.ik`` compatibility: ``pose`` is a position (column
+                3) and an approach direction (column 2); the roll is ``roll``, else the roll of
+                ``q_reference`` (else free).
+            select: ``"nearest"`` (the only rule for every robot; the AL5's ``"report"`` rule
+                lives in ``lynxplan.arm``).
+            verify: Also re-check each branch with Pinocchio's FK (adds ~5 us per branch). Every
+                branch is always verified by the solver's FK of the exact chain (the same
+                product of exponentials; equal to Pinocchio's to 1e-15 m in the tests).
+
+        Raises:
+            ShapeError, NonFiniteInputError, TargetError: malformed target.
+        """
+        if pose is not None and np.shape(pose) != (4, 4):
+            raise ShapeError("pose", "(4, 4)", np.shape(pose))
+        if select != "nearest":
+            raise TargetError(f"select must be 'nearest' for a Robot. Got: {select!r}")
+        if approach_only:
+            if pose is None:
+                raise TargetError("approach_only needs a pose (position and approach columns)")
+            frame = np.asarray(pose, dtype=float)
+            if roll is None and q_reference is not None:
+                roll = float(np.asarray(q_reference, dtype=float).reshape(-1)[-1])
+            pose, position, approach = None, frame[:3, 3], frame[:3, 2]
+        if (
+            pose is not None
+            and q_reference is None
+            and roll is None
+            and self.family is not None
+            and self._arm is None
+        ):
+            return self._ik_pose_fast(pose, verify)
+        target = make_target(
+            pose,
+            position,
+            approach,
+            None if pitch is None else [pitch],
+            None if roll is None else [roll],
+        )
+        reference = self._reference(q_reference, 1)
+        batch = self._solve(target, reference)
+        return self._single(batch, reference[0], verify)
+
+    def _ik_pose_fast(self, pose: Any, verify: bool) -> RobotIkResult:
+        """Full-pose IK of one pose with the least Python around the kernel (same answers)."""
+        from lynxplan.robots.ik import family_kernel as fk_
+        from lynxplan.robots.ik.family_solver import branch_names
+
+        family = self.family
+        assert family is not None
+        poses = np.array(pose, dtype=float).reshape(1, 4, 4)
+        if not np.isfinite(poses).all():
+            raise NonFiniteInputError("pose")
+        slots = 4 if family.tool_on_roll_axis else 4 * fk_.MAX_ROOTS
+        q = np.empty((1, slots, 5))
+        valid = np.empty((1, slots), dtype=np.bool_)
+        within = np.empty((1, slots), dtype=np.bool_)
+        perr, oerr, miss = np.empty((1, slots)), np.empty((1, slots)), np.empty((1, slots))
+        fk_.family_ik_kernel(
+            family.packed,
+            self.chain.placements,
+            self.chain.axes,
+            poses,
+            0,
+            _ZERO1,
+            _NAN1,
+            self._zero_reference,
+            q,
+            valid,
+            within,
+            perr,
+            oerr,
+            miss,
+        )
+        if not family.exact:
+            from lynxplan.robots.ik.family_solver import rescue_near_axis
+
+            one = Target(poses, 0, _ZERO1, _NAN1)
+            rescue_near_axis(self, one, q, valid, within, perr, oerr)
+        distance = float(np.where(valid, perr, np.inf).min())
+        reachable = distance <= REACH_TOLERANCE
+        if reachable:
+            valid &= perr <= REACH_TOLERANCE
+        batch = RobotIkBatch(
+            q,
+            valid,
+            within,
+            perr,
+            oerr,
+            np.array([reachable]),
+            np.array([distance]),
+            branch_names(slots),
+        )
+        return self._single(batch, self._zero_reference[0], verify)
+
+    def _single(self, batch: RobotIkBatch, reference: np.ndarray, verify: bool) -> RobotIkResult:
+        slots = np.flatnonzero(batch.valid[0])
+        solutions = []
+        for b in slots:
+            q = np.array(batch.q[0, b])
+            q.setflags(write=False)
+            solutions.append(
+                RobotIkSolution(
+                    q,
+                    batch.branch_names[b],
+                    bool(batch.within_limits[0, b]),
+                    float(batch.position_error[0, b]),
+                    float(batch.orientation_error[0, b]),
+                )
+            )
+        if verify:
+            self._verify(solutions, batch)
+        best, best_cost = None, np.inf
+        for i, s in enumerate(solutions):
+            if not s.within_limits or s.position_error > batch.distance[0] + REACH_TOLERANCE:
+                continue
+            cost = float(np.sum((s.q - reference) ** 2))
+            if cost < best_cost:
+                best, best_cost = i, cost
+        ranked = (
+            best
+            if best is not None
+            else (int(np.argmin([s.orientation_error for s in solutions])) if solutions else None)
+        )
+        residual = float(solutions[ranked].orientation_error) if ranked is not None else np.nan
+        return RobotIkResult(
+            tuple(solutions),
+            best,
+            bool(batch.reachable[0]),
+            float(batch.distance[0]),
+            residual,
+            self.ik_solver,
+        )
+
+    def _verify(self, solutions: list[RobotIkSolution], batch: RobotIkBatch) -> None:
+        """Pinocchio FK of each branch must agree with the solver's own FK (1e-12 m)."""
+        from lynxplan.exceptions import IkFailedError
+
+        for s in solutions:
+            placement = self.frame_placement(s.q)
+            own = self.fk(s.q)
+            gap = float(np.abs(placement[:3] - own[:3]).max())
+            if gap > 1e-12:
+                raise IkFailedError(s.position_error, f"Pinocchio FK disagrees by {gap:.3g} m")
+
+    def ik_track(
+        self,
+        poses: Any = None,
+        q0: Any = None,
+        *,
+        positions: Any = None,
+        approaches: Any = None,
+        pitches: Any = None,
+        rolls: Any = None,
+        jump_threshold: float = TRACK_JUMP_THRESHOLD,
+    ) -> TrackResult:
+        """IK along a sequence of targets, each step on the branch nearest the previous step.
+
+        Args:
+            poses / positions + approaches / pitches, rolls: N targets as in :meth:`ik_batch`.
+            q0: Configuration before the first target, shape (n,), [rad]. Default: zeros.
+            jump_threshold: A step changing some joint by more than this [rad] is flagged.
+
+        Returns:
+            A :class:`TrackResult`: the configurations, the branch per step, the flagged jumps
+            (index, size) and the unsolved indices; never a silent branch flip.
+        """
+        target = make_target(poses, positions, approaches, pitches, rolls)
+        start = self._reference(q0, 1)[0]
+        n = target.poses.shape[0]
+        q = np.full((n, self.nq), np.nan)
+        branch = np.full(n, -1, dtype=np.int64)
+        jumps: list[TrackJump] = []
+        unsolved: list[int] = []
+        previous = start.copy()
+        max_step = 0.0
+        for k in range(n):
+            one = Target(
+                target.poses[k : k + 1],
+                target.kind,
+                target.pitch[k : k + 1],
+                target.roll[k : k + 1],
+            )
+            batch = self._solve(one, previous.reshape(1, -1))
+            ok = (
+                batch.valid[0]
+                & batch.within_limits[0]
+                & (batch.position_error[0] <= batch.distance[0] + REACH_TOLERANCE)
+            )
+            if not ok.any():
+                unsolved.append(k)
+                continue
+            steps = np.abs(batch.q[0] - previous).max(axis=1)
+            steps[~ok] = np.inf
+            b = int(np.argmin(steps))
+            q[k], branch[k] = batch.q[0, b], b
+            size = float(steps[b])
+            if k > 0 or q0 is not None:
+                max_step = max(max_step, size)
+                if size > jump_threshold:
+                    jumps.append(TrackJump(k, size))
+            previous = q[k].copy()
+        q.setflags(write=False)
+        branch.setflags(write=False)
+        return TrackResult(q, branch, tuple(jumps), tuple(unsolved), max_step)
+
+    # -- workspace -----------------------------------------------------------------------------
+    def workspace(self, samples: int = 100_000, seed: int = 0) -> np.ndarray:
+        """Tool points of uniformly random configurations within the limits.
+
+        Returns: shape (samples, 3), in [m].
+        """
+        rng = np.random.default_rng(seed)
+        q = rng.uniform(self.limits.lower, self.limits.upper, size=(int(samples), self.nq))
+        return np.array(self.fk(q)[:, :3, 3])
+
+    def random_configurations(self, count: int, seed: int = 0) -> np.ndarray:
+        """Uniformly random configurations within the limits, shape (count, n), in [rad]."""
+        rng = np.random.default_rng(seed)
+        return rng.uniform(self.limits.lower, self.limits.upper, size=(int(count), self.nq))
