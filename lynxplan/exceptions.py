@@ -525,6 +525,5 @@ class IkFailedError(RobotError, KinematicsError):
 
     def __init__(self, position_error: float, detail: str = "") -> None:
         self.position_error = position_error
-        super().__init__(
-            f"IK failed: best position error {position_error:.3g} m{'; ' + detail if detail else ''}"
-        )
+        suffix = f"; {detail}" if detail else ""
+        super().__init__(f"IK failed: best position error {position_error:.3g} m{suffix}")

@@ -7,6 +7,7 @@ import sys
 
 import httpx
 import pytest
+import yaml
 from service_server import REPO, SCENARIOS, Server
 
 from lynxplan.client import Client, ServiceError
@@ -79,7 +80,10 @@ def test_health_needs_no_token_and_the_right_token_works(guarded: Server) -> Non
 def test_a_run_over_its_time_limit_fails(guarded: Server) -> None:
     # (a replaced worker serving the next run is tested by test_cancel_a_queued_or_running_run)
     with Client(guarded.url, token=TOKEN) as client:
-        slow = client.run(SCENARIOS / "ok_task.yaml")  # plots and HTML: far over 3 s
+        # An unsolvable planning problem searches for its whole time budget: 30 s > 3 s.
+        scenario = yaml.safe_load((SCENARIOS / "planning" / "u01_goal_in_jar.yaml").read_text())
+        scenario["planner"].update(time_limit=30.0, max_nodes=10_000_000)
+        slow = client.run(scenario, quick=True)
         assert slow.state == "failed" and "time limit of 3 s" in slow.error, slow
         assert slow.artifacts == () and slow.timings["total"] < 60
 
