@@ -44,7 +44,11 @@ def _declared() -> set[str]:
 
 
 #: Modules whose distribution the metadata does not map (cmeel wheels install under a prefix).
-KNOWN = {"pinocchio": ["pin"]}
+KNOWN = {
+    "pinocchio": ["pin"],
+    "example_robot_data": ["example-robot-data-loaders"],
+    "pink": ["pin-pink"],  # a peer: installed only in its own venv
+}
 
 
 def test_every_imported_package_is_declared() -> None:
