@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import ipaddress
+import math
 import os
 from pathlib import Path
 from typing import Any
@@ -43,6 +44,13 @@ def handle(args: argparse.Namespace) -> int:
         )
     if args.workers < 1 or not 0 < args.port < 65536:
         raise InputError("--workers must be >= 1 and --port within 1..65535")
+    for option, value in (
+        ("--max-body", args.max_body),
+        ("--run-memory", args.run_memory),
+        ("--run-timeout", args.run_timeout),
+    ):
+        if not (isinstance(value, (int, float)) and math.isfinite(value) and value > 0):
+            raise InputError(f"{option} must be a finite number > 0. Got: {value}")
     _check_data_dir(Path(args.data_dir))
     config = ServiceConfig(
         data_dir=Path(args.data_dir), workers=args.workers, token=token,
