@@ -45,6 +45,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.collision._kernels import _multiply
 from lynxplan.collision.obstacles import BoxObstacle, CylinderObstacle, SphereObstacle
 from lynxplan.collision.world import CollisionWorld
 
@@ -265,17 +266,7 @@ def _obstacle_arrays(world: CollisionWorld) -> tuple[np.ndarray, ...]:
 # -- compiled kernels ---------------------------------------------------------------------------
 
 
-@numba.njit(cache=True, fastmath=False)
-def _compose(a: np.ndarray, b: np.ndarray, out: np.ndarray) -> None:
-    """out = a @ b for 4x4 rigid transforms."""
-    for i in range(3):
-        for j in range(4):
-            out[i, j] = a[i, 0] * b[0, j] + a[i, 1] * b[1, j] + a[i, 2] * b[2, j]
-        out[i, 3] += a[i, 3]
-    out[3, 0] = 0.0
-    out[3, 1] = 0.0
-    out[3, 2] = 0.0
-    out[3, 3] = 1.0
+_compose = _multiply  # out = a @ b for 4x4 rigid transforms (the collision kernels' own)
 
 
 @numba.njit(cache=True)
