@@ -51,6 +51,23 @@ def located_error(loc: tuple[int | str, ...], message: str, value: Any = None) -
     )
 
 
+def check_target_form(entry: Any) -> None:
+    """A waypoint or goal gives exactly one of ``q``, ``pose`` (3 or 4 rows of 4) or
+    ``position`` + ``approach`` (non-zero); ValueError naming what is wrong otherwise."""
+    given = [name for name in ("q", "pose", "position") if getattr(entry, name) is not None]
+    if len(given) != 1:
+        raise ValueError(f"give exactly one of q, pose, position (got: {given or 'none'})")
+    if (entry.position is None) != (entry.approach is None):
+        raise ValueError("position and approach go together")
+    if entry.approach is not None and not any(entry.approach):
+        raise ValueError("approach must not be the zero vector")
+    if entry.pose is not None:
+        if any(len(row) != 4 for row in entry.pose):
+            raise ValueError("pose rows must have 4 values")
+        if len(entry.pose) == 4 and entry.pose[3] != [0, 0, 0, 1]:
+            raise ValueError("the 4th pose row must be [0, 0, 0, 1]")
+
+
 class StrictModel(BaseModel):
     """Base of every scenario schema: unknown keys are errors, values are frozen, and NaN or
     infinity is refused in every float field (issue 12: a NaN tolerance disables a check)."""

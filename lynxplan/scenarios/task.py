@@ -60,6 +60,7 @@ from lynxplan.scenarios.base import (
     ScenarioModel,
     StrictModel,
     Units,
+    check_target_form,
     located_error,
     scale_translation,
     scaled,
@@ -162,18 +163,7 @@ class WaypointEntry(StrictModel):
 
     @model_validator(mode="after")
     def _one_form(self) -> Self:
-        given = [name for name in ("q", "pose", "position") if getattr(self, name) is not None]
-        if len(given) != 1:
-            raise ValueError(f"give exactly one of q, pose, position (got: {given or 'none'})")
-        if (self.position is None) != (self.approach is None):
-            raise ValueError("position and approach go together")
-        if self.approach is not None and not any(self.approach):
-            raise ValueError("approach must not be the zero vector")
-        if self.pose is not None:
-            if any(len(row) != 4 for row in self.pose):
-                raise ValueError("pose rows must have 4 values")
-            if len(self.pose) == 4 and self.pose[3] != [0, 0, 0, 1]:
-                raise ValueError("the 4th pose row must be [0, 0, 0, 1]")
+        check_target_form(self)
         return self
 
 
