@@ -1,0 +1,234 @@
+"""Newton polish of a closed-form branch on the exact chain, and the branch's errors (numba).
+
+A model only close to the family (URDF angles written to 5 digits) gets each closed-form answer
+polished by Newton's method on the exact chain, on the same five conditions the closed form
+solves. Angles are in [rad], lengths in [m]; ``prm`` is the packed vector of ``family.py``.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.chain import chain_fk
+from lynxplan.robots.ik.family_geometry import MODE_APPROACH, MODE_PITCH, MODE_POSE, rotate
+
+#: Newton iterations at most, and the largest condition at which it stops.
+NEWTON_STEPS = 40
+NEWTON_TOLERANCE = 1e-14
+#: Finite-difference step of the Jacobian of the conditions [rad].
+_FD_STEP = 1e-7
+
+
+@numba.njit(cache=True, nogil=True)
+def solve_in_place(a: np.ndarray, b: np.ndarray) -> bool:
+    """Solve a x = b (n x n, Gaussian elimination, partial pivoting); x into b, a destroyed.
+
+    Returns False (b undefined) when a pivot vanishes: a singular Jacobian. Replaces LAPACK
+    calls, whose per-call cost dominated the polish of 5x5 systems.
+    """
+    n = b.shape[0]
+    for col in range(n):
+        pivot, best = col, abs(a[col, col])
+        for row in range(col + 1, n):
+            if abs(a[row, col]) > best:
+                pivot, best = row, abs(a[row, col])
+        if not best > 1e-300:
+            return False
+        if pivot != col:
+            for j in range(col, n):
+                a[col, j], a[pivot, j] = a[pivot, j], a[col, j]
+            b[col], b[pivot] = b[pivot], b[col]
+        inv = 1.0 / a[col, col]
+        for row in range(col + 1, n):
+            factor = a[row, col] * inv
+            if factor != 0.0:
+                for j in range(col + 1, n):
+                    a[row, j] -= factor * a[col, j]
+                b[row] -= factor * b[col]
+    for col in range(n - 1, -1, -1):
+        total = b[col]
+        for j in range(col + 1, n):
+            total -= a[col, j] * b[j]
+        b[col] = total / a[col, col]
+    return True
+
+
+@numba.njit(cache=True, nogil=True)
+def conditions(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    roll_given: float,
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+    e: np.ndarray,
+) -> None:
+    """The five conditions the branch satisfies, evaluated on the exact chain."""
+    chain_fk(placements, axes, q, pose, work)
+    for i in range(3):
+        e[i] = pose[i, 3] - target[i, 3]
+    # approach axis and pitch axis of the reached configuration
+    rt = prm[F.RT0 : F.RT0 + 9]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    # approach in the tool frame: Rt0^T r
+    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
+    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
+    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
+    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
+    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
+    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+    cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
+    k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
+    pp0, pp1, pp2 = rotate(k0, k1, k2, cy, sy, prm[F.P], prm[F.P + 1], prm[F.P + 2])
+    if mode == MODE_PITCH:
+        h0, h1, h2 = rotate(k0, k1, k2, cy, sy, prm[F.H], prm[F.H + 1], prm[F.H + 2])
+        sp, cp = math.sin(pitch), math.cos(pitch)
+        t0, t1, t2 = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
+    else:
+        t0, t1, t2 = g[0, 3], g[1, 3], g[2, 3]
+    # in-plane approach angle matches: (a x at) . p = 0
+    c0 = a1 * t2 - a2 * t1
+    c1 = a2 * t0 - a0 * t2
+    c2 = a0 * t1 - a1 * t0
+    e[3] = c0 * pp0 + c1 * pp1 + c2 * pp2
+    if (
+        not math.isnan(roll_given)
+        or mode == MODE_PITCH
+        or (mode == MODE_APPROACH and prm[F.OFF_AXIS] == 0.0)
+    ):
+        e[4] = q[4] - roll_given
+    elif mode == MODE_APPROACH:  # the approach exactly: (a x at) . (a x p) = 0 as well
+        w0 = a1 * pp2 - a2 * pp1
+        w1 = a2 * pp0 - a0 * pp2
+        w2 = a0 * pp1 - a1 * pp0
+        e[4] = c0 * w0 + c1 * w1 + c2 * w2
+    else:  # best roll about the approach axis: a . vee(Rt R^T - R Rt^T) = 0
+        v0 = v1 = v2 = 0.0
+        for m in range(3):
+            v0 += target[2, m] * pose[1, m] - pose[2, m] * target[1, m]
+            v1 += target[0, m] * pose[2, m] - pose[0, m] * target[2, m]
+            v2 += target[1, m] * pose[0, m] - pose[1, m] * target[0, m]
+        e[4] = a0 * v0 + a1 * v1 + a2 * v2
+
+
+@numba.njit(cache=True, nogil=True)
+def polish(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    roll_given: float,
+    q: np.ndarray,
+    scratch: np.ndarray,
+    scratch4: np.ndarray,
+    scratch5: np.ndarray,
+) -> float:
+    """Newton's method on the five conditions, on the exact chain (finite-difference Jacobian).
+
+    Keeps the closed-form answer when Newton does not reduce the conditions (unreachable).
+    """
+    # scratch (6, 5): rows e, e2, qh, start, qt, step; (pose, work) in scratch4, jac in scratch5
+    pose, work = scratch4[0], scratch4[1]
+    e, e2, qh, start, qt = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
+    step = scratch[5]
+    jac = scratch5
+    start[:] = q
+    conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
+    first = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
+    norm = first
+    for _ in range(NEWTON_STEPS):
+        if norm < NEWTON_TOLERANCE or not math.isfinite(norm):
+            break
+        for j in range(5):
+            qh[:] = q
+            qh[j] += _FD_STEP
+            conditions(
+                prm, placements, axes, target, g, mode, pitch, roll_given, qh, pose, work, e2
+            )
+            for i in range(5):
+                jac[i, j] = (e2[i] - e[i]) / _FD_STEP
+        step[:] = e
+        if not solve_in_place(jac, step):
+            break
+        # backtracking: the full step unless it increases the conditions
+        t = 1.0
+        accepted = False
+        for _ in range(12):
+            for j in range(5):
+                qt[j] = q[j] - t * step[j]
+            conditions(
+                prm, placements, axes, target, g, mode, pitch, roll_given, qt, pose, work, e2
+            )
+            trial = max(abs(e2[0]), abs(e2[1]), abs(e2[2]), abs(e2[3]), abs(e2[4]))
+            if trial < norm:
+                q[:] = qt
+                e[:] = e2
+                norm = trial
+                accepted = True
+                break
+            t *= 0.5
+        if not accepted:
+            break
+    if not (norm <= first):
+        q[:] = start
+        return float(first)
+    return float(norm)
+
+
+@numba.njit(cache=True, nogil=True)
+def branch_orientation_error(
+    prm: np.ndarray,
+    target: np.ndarray,
+    g: np.ndarray,
+    mode: int,
+    pitch: float,
+    q: np.ndarray,
+    pose: np.ndarray,
+) -> float:
+    """Angle between target and reached orientation (pose) or approach axes (approach, pitch)."""
+    if mode == MODE_POSE:
+        s0 = s1 = s2 = 0.0
+        tr = 0.0
+        for i in range(3):
+            tr += target[0, i] * pose[0, i] + target[1, i] * pose[1, i] + target[2, i] * pose[2, i]
+        # vee of (Rt^T R - R^T Rt): rows of Rt^T R are columns of Rt dotted with columns of R
+        m01 = m10 = m02 = m20 = m12 = m21 = 0.0
+        for r in range(3):
+            m01 += target[r, 0] * pose[r, 1]
+            m10 += target[r, 1] * pose[r, 0]
+            m02 += target[r, 0] * pose[r, 2]
+            m20 += target[r, 2] * pose[r, 0]
+            m12 += target[r, 1] * pose[r, 2]
+            m21 += target[r, 2] * pose[r, 1]
+        s0, s1, s2 = m21 - m12, m02 - m20, m10 - m01
+        return math.atan2(0.5 * math.sqrt(s0 * s0 + s1 * s1 + s2 * s2), 0.5 * (tr - 1.0))
+    rt = prm[F.RT0 : F.RT0 + 9]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
+    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
+    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
+    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
+    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
+    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+    if mode == MODE_PITCH:
+        k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
+        cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
+        h0, h1, h2 = rotate(k0, k1, k2, cy, sy, prm[F.H], prm[F.H + 1], prm[F.H + 2])
+        sp, cp = math.sin(pitch), math.cos(pitch)
+        t0, t1, t2 = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
+    else:
+        t0, t1, t2 = g[0, 3], g[1, 3], g[2, 3]
+    c0, c1, c2 = a1 * t2 - a2 * t1, a2 * t0 - a0 * t2, a0 * t1 - a1 * t0
+    return math.atan2(math.sqrt(c0 * c0 + c1 * c1 + c2 * c2), a0 * t0 + a1 * t1 + a2 * t2)
