@@ -21,98 +21,31 @@ import numpy as np
 
 from lynxplan.arm.geometry import JointLimits
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
-from lynxplan.exceptions import NonFiniteInputError, ShapeError, TargetError
+from lynxplan.exceptions import ShapeError, TargetError
 from lynxplan.robots import chain as _chain
 from lynxplan.robots.family import FamilyParameters, recognise_family
 from lynxplan.robots.loading import BuiltinRobot, LoadedModel
-from lynxplan.robots.results import (
-    JointInfo,
-    RobotIkBatch,
-    RobotIkResult,
-    RobotIkSolution,
-    RobotInfo,
-    TrackJump,
-    TrackResult,
+from lynxplan.robots.results import JointInfo, RobotIkBatch, RobotIkResult, RobotInfo, TrackResult
+from lynxplan.robots.selection import REACH_TOLERANCE, TRACK_JUMP_THRESHOLD, select_one, track
+from lynxplan.robots.targets import (
+    KIND_APPROACH,
+    KIND_PITCH,
+    KIND_POSE,
+    Target,
+    as_array,
+    make_target,
 )
 
-#: A branch reaches its target when FK puts the tool this close to the target position [m].
-REACH_TOLERANCE = 1e-9
-#: ik_track flags a step whose largest joint change exceeds this [rad].
-TRACK_JUMP_THRESHOLD = 0.5
-
-KIND_POSE, KIND_APPROACH, KIND_PITCH = 0, 1, 2
-_ZERO1 = np.zeros(1)
-_NAN1 = np.full(1, np.nan)
-
-
-class Target:
-    """IK targets in packed form (internal): poses (N, 4, 4), kind, pitch (N,), roll (N,)."""
-
-    def __init__(self, poses: np.ndarray, kind: int, pitch: np.ndarray, roll: np.ndarray) -> None:
-        self.poses, self.kind, self.pitch, self.roll = poses, kind, pitch, roll
-
-
-def _as_array(x: Any, name: str, shape_tail: tuple[int, ...]) -> np.ndarray:
-    array = np.asarray(x, dtype=float)
-    nd = len(shape_tail)
-    if array.shape[array.ndim - nd :] != shape_tail or array.ndim not in (nd, nd + 1):
-        expected = ", ".join(map(str, shape_tail))
-        raise ShapeError(name, f"({expected}) or (N, {expected})", array.shape)
-    if not np.isfinite(array).all():
-        raise NonFiniteInputError(name)
-    return array.reshape((-1, *shape_tail))
-
-
-def make_target(  # noqa: PLR0912 (one branch per target form)
-    poses: Any = None,
-    positions: Any = None,
-    approaches: Any = None,
-    pitches: Any = None,
-    rolls: Any = None,
-) -> Target:
-    """Pack one kind of target. Raises TargetError for a missing/contradictory combination."""
-    if poses is not None:
-        if positions is not None or approaches is not None or pitches is not None:
-            raise TargetError("give a pose, or a position with an approach or a pitch; not both")
-        array = _as_array(poses, "pose", (4, 4))
-        kind = KIND_POSE
-        n = array.shape[0]
-    else:
-        if positions is None:
-            raise TargetError("give a pose (4x4) or a position (x, y, z)")
-        pos = _as_array(positions, "position", (3,))
-        n = pos.shape[0]
-        array = np.tile(np.eye(4), (n, 1, 1))
-        array[:, :3, 3] = pos
-        if approaches is not None and pitches is not None:
-            raise TargetError("give an approach direction or a pitch, not both")
-        if approaches is not None:
-            app = _as_array(approaches, "approach", (3,))
-            norms = np.linalg.norm(app, axis=1)
-            if (norms < 1e-12).any():
-                raise TargetError("the approach direction must be a non-zero vector")
-            app = app / norms[:, None]
-            if app.shape[0] not in (1, n):
-                raise ShapeError("approach", f"(3,) or ({n}, 3)", app.shape)
-            array[:, :3, 2] = app
-            kind = KIND_APPROACH
-        elif pitches is not None:
-            kind = KIND_PITCH
-        else:
-            raise TargetError("a position needs an approach direction or a pitch")
-    pitch = np.zeros(n)
-    if pitches is not None:
-        p = np.asarray(pitches, dtype=float).reshape(-1)
-        if p.shape[0] not in (1, n) or not np.isfinite(p).all():
-            raise TargetError(f"pitch must be finite, one value or {n}")
-        pitch[:] = p
-    roll = np.full(n, np.nan)
-    if rolls is not None:
-        r = np.asarray(rolls, dtype=float).reshape(-1)
-        if r.shape[0] not in (1, n):
-            raise TargetError(f"roll must be one value or {n}")
-        roll[:] = r
-    return Target(np.ascontiguousarray(array), kind, pitch, roll)
+__all__ = [
+    "KIND_APPROACH",
+    "KIND_PITCH",
+    "KIND_POSE",
+    "REACH_TOLERANCE",
+    "TRACK_JUMP_THRESHOLD",
+    "Robot",
+    "Target",
+    "make_target",
+]
 
 
 class Robot:
@@ -233,7 +166,7 @@ class Robot:
 
     # -- kinematics ----------------------------------------------------------------------------
     def _configurations(self, q: Any, name: str = "q") -> np.ndarray:
-        return np.ascontiguousarray(_as_array(q, name, (self.nq,)))
+        return np.ascontiguousarray(as_array(q, name, (self.nq,)))
 
     def fk(self, q: Any) -> np.ndarray:
         """Tool pose. q: shape (n,) or (N, n) in [rad] -> (4, 4) or (N, 4, 4), in [m]."""
@@ -288,7 +221,7 @@ class Robot:
     def _reference(self, q_reference: Any, n: int) -> np.ndarray:
         if q_reference is None:
             return np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
-        ref = np.ascontiguousarray(_as_array(q_reference, "q_reference", (self.nq,)))
+        ref = np.ascontiguousarray(as_array(q_reference, "q_reference", (self.nq,)))
         if ref.shape[0] not in (1, n):
             raise ShapeError("q_reference", f"({self.nq},) or ({n}, {self.nq})", ref.shape)
         return ref
@@ -372,14 +305,6 @@ class Robot:
             if roll is None and q_reference is not None:
                 roll = float(np.asarray(q_reference, dtype=float).reshape(-1)[-1])
             pose, position, approach = None, frame[:3, 3], frame[:3, 2]
-        if (
-            pose is not None
-            and q_reference is None
-            and roll is None
-            and self.family is not None
-            and self._arm is None
-        ):
-            return self._ik_pose_fast(pose, verify)
         target = make_target(
             pose,
             position,
@@ -389,109 +314,7 @@ class Robot:
         )
         reference = self._reference(q_reference, 1)
         batch = self._solve(target, reference)
-        return self._single(batch, reference[0], verify)
-
-    def _ik_pose_fast(self, pose: Any, verify: bool) -> RobotIkResult:
-        """Full-pose IK of one pose with the least Python around the kernel (same answers)."""
-        from lynxplan.robots.ik import family_kernel as fk_
-        from lynxplan.robots.ik.family_solver import branch_names
-
-        family = self.family
-        assert family is not None
-        poses = np.array(pose, dtype=float).reshape(1, 4, 4)
-        if not np.isfinite(poses).all():
-            raise NonFiniteInputError("pose")
-        slots = 4 if family.tool_on_roll_axis else 4 * fk_.MAX_ROOTS
-        q = np.empty((1, slots, 5))
-        valid = np.empty((1, slots), dtype=np.bool_)
-        within = np.empty((1, slots), dtype=np.bool_)
-        perr, oerr, miss = np.empty((1, slots)), np.empty((1, slots)), np.empty((1, slots))
-        fk_.family_ik_kernel(
-            family.packed,
-            self.chain.placements,
-            self.chain.axes,
-            poses,
-            0,
-            _ZERO1,
-            _NAN1,
-            self._zero_reference,
-            q,
-            valid,
-            within,
-            perr,
-            oerr,
-            miss,
-        )
-        if not family.exact:
-            from lynxplan.robots.ik.family_solver import rescue_near_axis
-
-            one = Target(poses, 0, _ZERO1, _NAN1)
-            rescue_near_axis(self, one, q, valid, within, perr, oerr)
-        distance = float(np.where(valid, perr, np.inf).min())
-        reachable = distance <= REACH_TOLERANCE
-        if reachable:
-            valid &= perr <= REACH_TOLERANCE
-        batch = RobotIkBatch(
-            q,
-            valid,
-            within,
-            perr,
-            oerr,
-            np.array([reachable]),
-            np.array([distance]),
-            branch_names(slots),
-        )
-        return self._single(batch, self._zero_reference[0], verify)
-
-    def _single(self, batch: RobotIkBatch, reference: np.ndarray, verify: bool) -> RobotIkResult:
-        slots = np.flatnonzero(batch.valid[0])
-        solutions = []
-        for b in slots:
-            q = np.array(batch.q[0, b])
-            q.setflags(write=False)
-            solutions.append(
-                RobotIkSolution(
-                    q,
-                    batch.branch_names[b],
-                    bool(batch.within_limits[0, b]),
-                    float(batch.position_error[0, b]),
-                    float(batch.orientation_error[0, b]),
-                )
-            )
-        if verify:
-            self._verify(solutions, batch)
-        best, best_cost = None, np.inf
-        for i, s in enumerate(solutions):
-            if not s.within_limits or s.position_error > batch.distance[0] + REACH_TOLERANCE:
-                continue
-            cost = float(np.sum((s.q - reference) ** 2))
-            if cost < best_cost:
-                best, best_cost = i, cost
-        ranked = (
-            best
-            if best is not None
-            else (int(np.argmin([s.orientation_error for s in solutions])) if solutions else None)
-        )
-        residual = float(solutions[ranked].orientation_error) if ranked is not None else np.nan
-        return RobotIkResult(
-            tuple(solutions),
-            best,
-            bool(batch.reachable[0]),
-            float(batch.distance[0]),
-            residual,
-            self.ik_solver,
-        )
-
-    def _verify(self, solutions: list[RobotIkSolution], batch: RobotIkBatch) -> None:
-        """Pinocchio FK of each branch must agree with the solver's own FK (1e-12 m)."""
-        from lynxplan.exceptions import IkFailedError
-
-        for s in solutions:
-            placement = self.frame_placement(s.q)
-            own = self.fk(s.q)
-            gap = float(np.abs(placement[:3] - own[:3]).max())
-            if gap > 1e-12:
-                raise IkFailedError(s.position_error, f"Pinocchio FK disagrees by {gap:.3g} m")
+        return select_one(self, batch, reference[0], verify)
 
     def ik_track(
         self,
@@ -516,43 +339,7 @@ class Robot:
             (index, size) and the unsolved indices; never a silent branch flip.
         """
         target = make_target(poses, positions, approaches, pitches, rolls)
-        start = self._reference(q0, 1)[0]
-        n = target.poses.shape[0]
-        q = np.full((n, self.nq), np.nan)
-        branch = np.full(n, -1, dtype=np.int64)
-        jumps: list[TrackJump] = []
-        unsolved: list[int] = []
-        previous = start.copy()
-        max_step = 0.0
-        for k in range(n):
-            one = Target(
-                target.poses[k : k + 1],
-                target.kind,
-                target.pitch[k : k + 1],
-                target.roll[k : k + 1],
-            )
-            batch = self._solve(one, previous.reshape(1, -1))
-            ok = (
-                batch.valid[0]
-                & batch.within_limits[0]
-                & (batch.position_error[0] <= batch.distance[0] + REACH_TOLERANCE)
-            )
-            if not ok.any():
-                unsolved.append(k)
-                continue
-            steps = np.abs(batch.q[0] - previous).max(axis=1)
-            steps[~ok] = np.inf
-            b = int(np.argmin(steps))
-            q[k], branch[k] = batch.q[0, b], b
-            size = float(steps[b])
-            if k > 0 or q0 is not None:
-                max_step = max(max_step, size)
-                if size > jump_threshold:
-                    jumps.append(TrackJump(k, size))
-            previous = q[k].copy()
-        q.setflags(write=False)
-        branch.setflags(write=False)
-        return TrackResult(q, branch, tuple(jumps), tuple(unsolved), max_step)
+        return track(self, target, self._reference(q0, 1)[0], q0 is not None, jump_threshold)
 
     # -- workspace -----------------------------------------------------------------------------
     def workspace(self, samples: int = 100_000, seed: int = 0) -> np.ndarray:

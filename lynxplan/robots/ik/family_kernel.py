@@ -28,6 +28,7 @@ from lynxplan.robots.ik.family_geometry import (
     wrap_into_limits,
 )
 from lynxplan.robots.ik.family_polish import NEWTON_TOLERANCE, branch_orientation_error, polish
+from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms
 from lynxplan.robots.ik.roll_search import GRID_SIZE, MAX_ROOTS, ROOT_GRID, roll_candidates
 
 __all__ = [
@@ -87,14 +88,14 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
     if hi5 - lo5 > TWO_PI:
         hi5 = lo5 + TWO_PI
     rt0 = prm[F.RT0 : F.RT0 + 9]
-    g = np.empty((3, 4))  # G = Rt Rt0^T, then the target approach axis
+    g = np.empty((SCRATCH_ROWS, 4))  # G = Rt Rt0^T, the approach axis, roll constants
     pose, work = np.empty((4, 4)), np.empty((4, 4))
     roots = np.empty(2 * MAX_ROOTS)
     q = np.empty(5)
     trial = np.empty(5)
     scratch = np.empty((6, 5))
     scratch4 = np.empty((2, 4, 4))
-    scratch5 = np.empty((5, 5))
+    scratch5 = np.empty((6, 5))
     grid_x, grid_f = np.empty(GRID_SIZE), np.empty(GRID_SIZE)
     nearest = 0.0
     exact = prm[F.EXACT] != 0.0
@@ -120,6 +121,8 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                 g[i, 3] = target[i, 2]
         roll_given = roll[n]
         need_roots = off_axis and math.isnan(roll_given) and mode != MODE_PITCH
+        if need_roots:
+            prepare_roll_terms(prm, target, g)
         theta_fixed = sig5 * (ref[4] if math.isnan(roll_given) else roll_given)
         for b in range(nb):
             valid[n, b] = False

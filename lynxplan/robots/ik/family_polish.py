@@ -19,18 +19,22 @@ from lynxplan.robots.ik.family_geometry import MODE_APPROACH, MODE_PITCH, MODE_P
 #: Newton iterations at most, and the largest condition at which it stops.
 NEWTON_STEPS = 40
 NEWTON_TOLERANCE = 1e-14
+#: The chord method keeps its Jacobian while each step divides the conditions by 1 / CHORD_RATE.
+CHORD_RATE = 1e-3
 #: Finite-difference step of the Jacobian of the conditions [rad].
 _FD_STEP = 1e-7
 
 
 @numba.njit(cache=True, nogil=True)
-def solve_in_place(a: np.ndarray, b: np.ndarray) -> bool:
-    """Solve a x = b (n x n, Gaussian elimination, partial pivoting); x into b, a destroyed.
+def lu_factor(a: np.ndarray) -> bool:
+    """LU factors of the square a[:n] (n = columns) in place, partial pivoting; the row order
+    goes to a[n] (as floats). Returns False when a pivot vanishes (a singular matrix).
 
-    Returns False (b undefined) when a pivot vanishes: a singular Jacobian. Replaces LAPACK
-    calls, whose per-call cost dominated the polish of 5x5 systems.
+    Replaces LAPACK calls, whose per-call cost dominated the polish of 5x5 systems.
     """
-    n = b.shape[0]
+    n = a.shape[1]
+    for i in range(n):
+        a[n, i] = i
     for col in range(n):
         pivot, best = col, abs(a[col, col])
         for row in range(col + 1, n):
@@ -39,22 +43,33 @@ def solve_in_place(a: np.ndarray, b: np.ndarray) -> bool:
         if not best > 1e-300:
             return False
         if pivot != col:
-            for j in range(col, n):
+            for j in range(n):
                 a[col, j], a[pivot, j] = a[pivot, j], a[col, j]
-            b[col], b[pivot] = b[pivot], b[col]
+            a[n, col], a[n, pivot] = a[n, pivot], a[n, col]
         inv = 1.0 / a[col, col]
         for row in range(col + 1, n):
             factor = a[row, col] * inv
+            a[row, col] = factor
             if factor != 0.0:
                 for j in range(col + 1, n):
                     a[row, j] -= factor * a[col, j]
-                b[row] -= factor * b[col]
-    for col in range(n - 1, -1, -1):
-        total = b[col]
-        for j in range(col + 1, n):
-            total -= a[col, j] * b[j]
-        b[col] = total / a[col, col]
     return True
+
+
+@numba.njit(cache=True, nogil=True)
+def lu_solve(lu: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
+    """x = a^-1 b from the factors of ``lu_factor``."""
+    n = lu.shape[1]
+    for i in range(n):
+        total = b[int(lu[n, i])]
+        for j in range(i):
+            total -= lu[i, j] * x[j]
+        x[i] = total
+    for i in range(n - 1, -1, -1):
+        total = x[i]
+        for j in range(i + 1, n):
+            total -= lu[i, j] * x[j]
+        x[i] = total / lu[i, i]
 
 
 @numba.njit(cache=True, nogil=True)
@@ -135,11 +150,14 @@ def polish(
     scratch4: np.ndarray,
     scratch5: np.ndarray,
 ) -> float:
-    """Newton's method on the five conditions, on the exact chain (finite-difference Jacobian).
+    """Newton's method on the five conditions, on the exact chain (finite-difference Jacobian,
+    kept while it converges fast: the chord method; refreshed when a step gains less than
+    :data:`CHORD_RATE` or fails).
 
     Keeps the closed-form answer when Newton does not reduce the conditions (unreachable).
     """
-    # scratch (6, 5): rows e, e2, qh, start, qt, step; (pose, work) in scratch4, jac in scratch5
+    # scratch (6, 5): rows e, e2, qh, start, qt, step; (pose, work) in scratch4;
+    # scratch5 (6, 5): the LU factors of the Jacobian and their row order
     pose, work = scratch4[0], scratch4[1]
     e, e2, qh, start, qt = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     step = scratch[5]
@@ -148,23 +166,27 @@ def polish(
     conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
     first = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
     norm = first
+    factored = fresh = False
     for _ in range(NEWTON_STEPS):
         if norm < NEWTON_TOLERANCE or not math.isfinite(norm):
             break
-        for j in range(5):
-            qh[:] = q
-            qh[j] += _FD_STEP
-            conditions(
-                prm, placements, axes, target, g, mode, pitch, roll_given, qh, pose, work, e2
-            )
-            for i in range(5):
-                jac[i, j] = (e2[i] - e[i]) / _FD_STEP
-        step[:] = e
-        if not solve_in_place(jac, step):
-            break
+        if not factored:
+            for j in range(5):
+                qh[:] = q
+                qh[j] += _FD_STEP
+                conditions(
+                    prm, placements, axes, target, g, mode, pitch, roll_given, qh, pose, work, e2
+                )
+                for i in range(5):
+                    jac[i, j] = (e2[i] - e[i]) / _FD_STEP
+            if not lu_factor(jac):
+                break
+            factored = fresh = True
+        lu_solve(jac, e, step)
         # backtracking: the full step unless it increases the conditions
         t = 1.0
         accepted = False
+        before = norm
         for _ in range(12):
             for j in range(5):
                 qt[j] = q[j] - t * step[j]
@@ -179,8 +201,11 @@ def polish(
                 accepted = True
                 break
             t *= 0.5
-        if not accepted:
+        if not accepted and fresh:
             break
+        # a stale Jacobian that no longer converges fast is computed again at the new point
+        factored = accepted and norm <= CHORD_RATE * before
+        fresh = False
     if not (norm <= first):
         q[:] = start
         return float(first)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -16,6 +17,7 @@ _SIDES = ("front", "back")
 _ELBOWS = ("elbow-up", "elbow-down")
 
 
+@functools.cache
 def branch_names(slots: int) -> tuple[str, ...]:
     """Names of the branch slots: side/elbow (4 slots) or side/roll-i/elbow (root search)."""
     if slots == 4:
@@ -38,7 +40,7 @@ def needs_root_search(robot: Robot, target: Target) -> bool:
 
 def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIkBatch:
     """Every branch of each target (see ``family_kernel``)."""
-    from lynxplan.robots.robot import REACH_TOLERANCE
+    from lynxplan.robots.selection import REACH_TOLERANCE
 
     family = robot.family
     assert family is not None
@@ -110,6 +112,8 @@ def rescue_near_axis(
     if family.exact or family.tool_on_roll_axis or target.kind == fk_.MODE_PITCH:
         return
     exact_count = np.count_nonzero(valid & (oerr <= 1e-9), axis=1)
+    if exact_count.all():  # every target has an exact branch: nothing to rescue
+        return
     lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
     approach_only = target.kind == fk_.MODE_APPROACH
     if approach_only:

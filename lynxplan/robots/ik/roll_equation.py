@@ -20,7 +20,6 @@ from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
     best_roll,
-    best_roll_terms,
     pitch_sum,
     yaw,
 )
@@ -83,6 +82,50 @@ def _reference_terms(
     return math.sin(delta), math.cos(delta), miss
 
 
+#: Rows of the kernel's scratch ``g`` (shape (SCRATCH_ROWS, 4)): 0-2 hold G = Rt Rt0^T and the
+#: approach axis; 3-8 the per-target constants of the roll equation (``prepare_roll_terms``):
+#: row 3 (rho, cos alpha, sin alpha, a.p), row 4 (a.h, a.k, cos gamma0, sin gamma0), row 5 the
+#: roll axis in (h, k, p), rows 6-8 G in the canonical basis (h, k, p).
+SCRATCH_ROWS = 9
+
+
+@numba.njit(cache=True, nogil=True)
+def prepare_roll_terms(prm: np.ndarray, target: np.ndarray, g: np.ndarray) -> None:
+    """Store the roll-independent parts of the roll equation of one target in g[3:9]."""
+    d0 = target[0, 3] - prm[F.C1]
+    d1 = target[1, 3] - prm[F.C1 + 1]
+    d2 = target[2, 3] - prm[F.C1 + 2]
+    dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
+    dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
+    rho = math.hypot(dp, dh)
+    g[3, 0] = rho
+    g[3, 1] = dp / rho if rho > 0.0 else 1.0
+    g[3, 2] = dh / rho if rho > 0.0 else 0.0
+    g[3, 3] = g[0, 3] * prm[F.P] + g[1, 3] * prm[F.P + 1] + g[2, 3] * prm[F.P + 2]
+    g[4, 0] = g[0, 3] * prm[F.H] + g[1, 3] * prm[F.H + 1] + g[2, 3] * prm[F.H + 2]
+    g[4, 1] = g[0, 3] * prm[F.K] + g[1, 3] * prm[F.K + 1] + g[2, 3] * prm[F.K + 2]
+    g[4, 2], g[4, 3] = math.cos(prm[F.GAMMA0]), math.sin(prm[F.GAMMA0])
+    for i, base in enumerate((F.H, F.K, F.P)):
+        g[5, i] = prm[F.R] * prm[base] + prm[F.R + 1] * prm[base + 1] + prm[F.R + 2] * prm[base + 2]
+    # Gc = B^T G B with B = [h k p] (a rotation: h x k = p)
+    for i, bi in enumerate((F.H, F.K, F.P)):
+        for j, bj in enumerate((F.H, F.K, F.P)):
+            total = 0.0
+            for a in range(3):
+                row = g[a, 0] * prm[bj] + g[a, 1] * prm[bj + 1] + g[a, 2] * prm[bj + 2]
+                total += prm[bi + a] * row
+            g[6 + i, j] = total
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _turn(
+    x: float, y: float, z: float, cphi: float, sphi: float, cbig: float, sbig: float
+) -> tuple[float, float, float]:
+    """R(p, -Phi) R(k, -phi) (x, y, z) in the canonical basis (x = h, y = k, z = p)."""
+    x1 = x * cphi - z * sphi
+    return x1 * cbig + y * sbig, y * cbig - x1 * sbig, x * sphi + z * cphi
+
+
 @numba.njit(cache=True, nogil=True)
 def roll_terms(
     prm: np.ndarray,
@@ -96,13 +139,11 @@ def roll_terms(
 ) -> tuple[float, float, float]:
     """(f, c, lateral miss) at roll theta: f the roll equation; for full poses f and c are the
     sine and cosine of the best-roll mismatch (c = 1 for approach targets); the lateral miss
-    [m] > 0 where the yaw circle is out of reach (the yaw is clamped there)."""
-    d0 = target[0, 3] - prm[F.C1]
-    d1 = target[1, 3] - prm[F.C1 + 1]
-    d2 = target[2, 3] - prm[F.C1 + 2]
-    dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
-    dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
-    rho = math.hypot(dp, dh)
+    [m] > 0 where the yaw circle is out of reach (the yaw is clamped there).
+
+    ``g`` holds the target's constants (``prepare_roll_terms``).
+    """
+    rho = g[3, 0]
     if rho <= _DEGENERATE:
         return _reference_terms(prm, target, g, mode, theta, side, phi_ref, sum_ref)
     ct, st = math.cos(theta), math.sin(theta)
@@ -114,26 +155,34 @@ def roll_terms(
     elif cb < -1.0:
         miss, cb = -lat - rho, -1.0
     sb = math.sqrt(max(0.0, 1.0 - cb * cb))
-    ca, sa = dp / rho, dh / rho
+    ca, sa = g[3, 1], g[3, 2]
     if side == 0:
         cphi, sphi = ca * cb + sa * sb, sa * cb - ca * sb
     else:
         cphi, sphi = ca * cb - sa * sb, sa * cb + ca * sb
-    a0, a1, a2 = g[0, 3], g[1, 3], g[2, 3]
-    ap = a0 * prm[F.P] + a1 * prm[F.P + 1] + a2 * prm[F.P + 2]
-    ah = a0 * prm[F.H] + a1 * prm[F.H + 1] + a2 * prm[F.H + 2]
-    ak = a0 * prm[F.K] + a1 * prm[F.K + 1] + a2 * prm[F.K + 2]
+    ap, ah, ak = g[3, 3], g[4, 0], g[4, 1]
     if mode == MODE_APPROACH:  # the out-of-plane approach component (see ``approach_in_plane``)
         return cphi * ap + sphi * ah, 1.0, miss
     in_h = cphi * ah - sphi * ap
-    norm = math.hypot(in_h, ak)
+    norm = math.sqrt(in_h * in_h + ak * ak)
     if norm <= _DEGENERATE:  # approach along the pitch axis: the reference pitch sum
         return _reference_terms(prm, target, g, mode, theta, side, phi_ref, sum_ref)
     # pitch sum Phi = atan2(ak, in_h) - gamma0
-    cg, sg = math.cos(prm[F.GAMMA0]), math.sin(prm[F.GAMMA0])
+    cg, sg = g[4, 2], g[4, 3]
     cbig, sbig = (in_h * cg + ak * sg) / norm, (ak * cg - in_h * sg) / norm
-    sine, cosine = best_roll_terms(prm, g, cphi, -sphi, cbig, -sbig)
-    size = math.hypot(sine, cosine)
+    # M = R(p, -Phi) R(k, -phi) Gc in the canonical basis (x = h, y = k, z = p)
+    m00, m10, m20 = _turn(g[6, 0], g[7, 0], g[8, 0], cphi, sphi, cbig, sbig)
+    m01, m11, m21 = _turn(g[6, 1], g[7, 1], g[8, 1], cphi, sphi, cbig, sbig)
+    m02, m12, m22 = _turn(g[6, 2], g[7, 2], g[8, 2], cphi, sphi, cbig, sbig)
+    r0, r1, r2 = g[5, 0], g[5, 1], g[5, 2]
+    sine = r0 * (m21 - m12) + r1 * (m02 - m20) + r2 * (m10 - m01)
+    rmr = (
+        r0 * (m00 * r0 + m01 * r1 + m02 * r2)
+        + r1 * (m10 * r0 + m11 * r1 + m12 * r2)
+        + r2 * (m20 * r0 + m21 * r1 + m22 * r2)
+    )
+    cosine = m00 + m11 + m22 - rmr
+    size = math.sqrt(sine * sine + cosine * cosine)
     if size == 0.0:  # atan2(0, 0) = 0: the best roll is 0
         return -st, ct, miss
     # sin and cos of (best roll - theta)
