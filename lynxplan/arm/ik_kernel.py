@@ -117,7 +117,7 @@ def _mark_unsolved(k: int, status: int, out: IkOutputs) -> None:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
+def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
     if lo <= x <= hi:
         return x, True
@@ -239,8 +239,8 @@ def _write_branches(
     lower, upper, tol = params.lower, params.upper, params.limit_tol
     # q3 takes the values -q3_abs and +q3_abs, q1 and q5 one value per base branch: wrap
     # each once (14 wraps a pose instead of 20).
-    q3_neg, q3_neg_in = _wrap_into_limits(-q3_abs, lower[2], upper[2], tol)
-    q3_pos, q3_pos_in = _wrap_into_limits(q3_abs, lower[2], upper[2], tol)
+    q3_neg, q3_neg_in = wrap_into_limits(-q3_abs, lower[2], upper[2], tol)
+    q3_pos, q3_pos_in = wrap_into_limits(q3_abs, lower[2], upper[2], tol)
     for base in range(2):
         # The back branch (plane direction reversed) follows from identities instead of more
         # atan2 calls: q1 + pi, q234 -> -q234, phi -> pi - phi, q5 + pi.
@@ -253,15 +253,15 @@ def _write_branches(
             if not params.approach_only:
                 q5 = q5_front - math.pi if q5_front > 0.0 else q5_front + math.pi
             r_b = -r_w
-        q1_wrapped, q1_in = _wrap_into_limits(q1, lower[0], upper[0], tol)
-        q5_wrapped, q5_in = _wrap_into_limits(q5, lower[4], upper[4], tol)
+        q1_wrapped, q1_in = wrap_into_limits(q1, lower[0], upper[0], tol)
+        q5_wrapped, q5_in = wrap_into_limits(q5, lower[4], upper[4], tol)
         for elbow in range(2):
             # Elbow above the shoulder-wrist line: q3 < 0 when the wrist is ahead (r_b >= 0).
             negative = (elbow == 0) == (r_b >= 0.0)
             q2 = phi + beta if negative else phi - beta
             q4 = q234 - q2 - (-q3_abs if negative else q3_abs)
-            q2_wrapped, q2_in = _wrap_into_limits(q2, lower[1], upper[1], tol)
-            q4_wrapped, q4_in = _wrap_into_limits(q4, lower[3], upper[3], tol)
+            q2_wrapped, q2_in = wrap_into_limits(q2, lower[1], upper[1], tol)
+            q4_wrapped, q4_in = wrap_into_limits(q4, lower[3], upper[3], tol)
             branch = 2 * base + elbow
             q_out[k, branch, 0] = q1_wrapped
             q_out[k, branch, 1] = q2_wrapped

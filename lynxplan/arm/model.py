@@ -7,23 +7,23 @@ of the same structure with other dimensions works through the same closed forms.
 
 from __future__ import annotations
 
-import math
-import os
-import sys
-import tempfile
-from collections.abc import Callable, Iterator
-from contextlib import contextmanager
-from dataclasses import dataclass
 from functools import cached_property
-from importlib import resources
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, Literal, NamedTuple
+from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from lynxplan import guards
 from lynxplan.arm.configuration import as_configurations
-from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
+from lynxplan.arm.geometry import TOOL_FRAME
+from lynxplan.arm.ik_result import IkResult, IkSolution
+from lynxplan.arm.urdf import (
+    DEFAULT_URDF_NAME,
+    default_urdf_path,
+    native_stderr_captured,
+    read_geometry,
+    read_limits,
+)
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
     RIGIDITY_REPAIR_TOLERANCE,
@@ -33,12 +33,21 @@ from lynxplan.exceptions import (
     InputError,
     ModelError,
     NonFiniteInputError,
-    NoSolutionWithinLimitsError,
     NotRigidTransformError,
     OrientationNotReachableError,
     ShapeError,
     UnreachablePoseError,
 )
+
+__all__ = [
+    "DEFAULT_URDF_NAME",
+    "Arm",
+    "IkResult",
+    "IkSolution",
+    "default_urdf_path",
+    "load_arm",
+    "native_stderr_captured",
+]
 
 if TYPE_CHECKING:
     from types import ModuleType
@@ -58,69 +67,9 @@ def _ik() -> ModuleType:
     return _IK_MODULE
 
 
-DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
-#: Tolerance on the URDF's DH structure (rotations, zero offsets), unitless / [m].
-_STRUCTURE_TOLERANCE = 1e-9
 _ZEROS = np.zeros(5)
 _ZEROS.setflags(write=False)
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
-
-
-def default_urdf_path() -> Path:
-    """Path of the shipped AL5 URDF (package data when installed, ``urdf/`` in a checkout)."""
-    packaged = resources.files("lynxplan") / "_data" / "urdf" / DEFAULT_URDF_NAME
-    if packaged.is_file():
-        return Path(str(packaged))
-    return Path(__file__).resolve().parents[2] / "urdf" / DEFAULT_URDF_NAME
-
-
-class IkSolution(NamedTuple):
-    """One IK branch, checked by forward kinematics.
-
-    Attributes:
-        q: Joint angles, shape (5,), in [rad] (read-only).
-        branch: Branch name, e.g. ``"front/elbow-up"``.
-        within_limits: Whether q is within the joint limits (after snapping).
-        position_error: ``|p_fk(q) - p_target|``, in [m].
-        orientation_error: Angle between the FK rotation and the target, in [rad].
-    """
-
-    q: np.ndarray
-    branch: str
-    within_limits: bool
-    position_error: float
-    orientation_error: float
-
-
-@dataclass(frozen=True)
-class IkResult:
-    """IK of one pose.
-
-    Attributes:
-        solutions: Every branch (four), in :data:`lynxplan.arm.ik.BRANCH_NAMES` order.
-        selected: Index of the chosen solution, or None if none is within limits.
-        orientation_residual: Angle between target and nearest reachable orientation, [rad].
-    """
-
-    solutions: tuple[IkSolution, ...]
-    selected: int | None
-    orientation_residual: float
-
-    @property
-    def q(self) -> np.ndarray:
-        """The selected solution, shape (5,), in [rad].
-
-        Raises:
-            NoSolutionWithinLimitsError: if no branch is within the joint limits.
-        """
-        if self.selected is None:
-            raise NoSolutionWithinLimitsError(
-                "IK: no branch is within the joint limits: "
-                + "; ".join(
-                    f"{s.branch} {np.degrees(s.q).round(3).tolist()} deg" for s in self.solutions
-                )
-            )
-        return self.solutions[self.selected].q
 
 
 Selection = Literal["nearest", "report"]
@@ -151,8 +100,8 @@ class Arm:
                 extra = f" (parser: {detail})" if detail else ""
                 raise ModelError(f"cannot load URDF {self.urdf_path}: {exc}{extra}") from exc
         self.data = self.model.createData()
-        self.geometry = _read_geometry(self.model)
-        self.limits = _read_limits(self.model)
+        self.geometry = read_geometry(self.model)
+        self.limits = read_limits(self.model)
         self.tool_frame_id = self.model.getFrameId(TOOL_FRAME)
         # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance, limits.
         g = self.geometry
@@ -341,78 +290,6 @@ def _raise_for_status(status: int, miss: float, deviation: float) -> None:
         raise NotRigidTransformError(deviation, RIGIDITY_REPAIR_TOLERANCE)
     if status == ik_status.OUT_OF_REACH:
         raise UnreachablePoseError(miss)
-
-
-@contextmanager
-def native_stderr_captured() -> Iterator[Callable[[], str]]:
-    """Capture what native code (urdfdom, Pinocchio) writes to file descriptor 2 in the block.
-
-    Yields a function returning the captured text, so that a parser's own messages become part
-    of one clear error instead of noise on the user's terminal.
-    """
-    try:
-        saved = os.dup(2)
-    except OSError:  # no usable stderr descriptor (embedded interpreter): capture nothing
-        yield lambda: ""
-        return
-    with tempfile.TemporaryFile() as sink:
-
-        def captured() -> str:
-            return os.pread(sink.fileno(), 4096, 0).decode("utf-8", "replace")
-
-        sys.stderr.flush()
-        os.dup2(sink.fileno(), 2)
-        try:
-            yield captured
-        finally:
-            os.dup2(saved, 2)
-            os.close(saved)
-
-
-def _read_limits(model: Any) -> JointLimits:
-    position = np.column_stack((model.lowerPositionLimit, model.upperPositionLimit))
-    velocity = np.array(model.velocityLimit, dtype=float)
-    names = tuple(model.names)[1:]
-    for j, name in enumerate(names[: len(velocity)]):
-        lower, upper = float(position[j, 0]), float(position[j, 1])
-        if not (math.isfinite(lower) and math.isfinite(upper) and lower < upper):
-            raise ModelError(
-                f"joint {name}: position limits [{lower:g}, {upper:g}] rad must be finite with "
-                "lower < upper"
-            )
-        if not (math.isfinite(velocity[j]) and velocity[j] > 0):
-            raise ModelError(f"joint {name}: velocity limit {velocity[j]:g} rad/s must be > 0")
-    position.setflags(write=False)
-    velocity.setflags(write=False)
-    return JointLimits(position=position, velocity=velocity)
-
-
-def _read_geometry(model: Any) -> ArmGeometry:
-    """DH lengths from the joint placements; ModelError if the structure is not the AL5's."""
-    names = tuple(model.names)[1:]
-    if names != JOINT_NAMES or model.nq != 5:
-        raise ModelError(f"expected revolute joints {JOINT_NAMES}; the URDF has {names}")
-    rx90 = np.array([[1.0, 0, 0], [0, 0, -1.0], [0, 1.0, 0]])
-    placements = [model.jointPlacements[i] for i in range(1, 6)]
-    expected_rotations = (np.eye(3), rx90, np.eye(3), np.eye(3), rx90)
-    for name, placement, rotation in zip(JOINT_NAMES, placements, expected_rotations, strict=True):
-        if not np.allclose(placement.rotation, rotation, atol=_STRUCTURE_TOLERANCE):
-            raise ModelError(f"joint {name}: placement rotation is not the DH model's")
-    a2, a3 = placements[2].translation[0], placements[3].translation[0]
-    tool = model.frames[model.getFrameId(TOOL_FRAME)].placement
-    offsets = np.concatenate(
-        [placements[i].translation for i in (0, 1, 4)]
-        + [placements[2].translation[1:], placements[3].translation[1:], tool.translation[:2]]
-    )
-    if not np.allclose(offsets, 0.0, atol=_STRUCTURE_TOLERANCE) or min(a2, a3) <= 0:
-        raise ModelError("joint placements do not follow the DH model of SPEC Part 1")
-    for frame in (*DH_FRAMES, TOOL_FRAME):
-        if not model.existFrame(frame):
-            raise ModelError(f"the URDF has no frame {frame!r}")
-    d5 = tool.translation[2]
-    if not math.isfinite(d5) or d5 <= 0:
-        raise ModelError("the tool frame must lie ahead of the wrist along the approach axis")
-    return ArmGeometry(a2=float(a2), a3=float(a3), d5=float(d5))
 
 
 _DEFAULT_ARM: Arm | None = None

@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lynxplan.exceptions import NoSolutionWithinLimitsError
+from lynxplan.arm.ik_result import selected_q
 
 
 class RobotIkSolution(NamedTuple):
@@ -58,14 +58,7 @@ class RobotIkResult:
         Raises:
             NoSolutionWithinLimitsError: if no branch is within the joint limits.
         """
-        if self.selected is None:
-            raise NoSolutionWithinLimitsError(
-                "IK: no branch is within the joint limits: "
-                + "; ".join(
-                    f"{s.branch} {np.degrees(s.q).round(3).tolist()} deg" for s in self.solutions
-                )
-            )
-        return self.solutions[self.selected].q
+        return selected_q(self.solutions, self.selected)
 
 
 class RobotIkBatch(NamedTuple):

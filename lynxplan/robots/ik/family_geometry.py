@@ -38,21 +38,6 @@ def wrap(x: float) -> float:
     return x - TWO_PI * math.floor((x + math.pi) / TWO_PI)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
-    """x moved by whole turns into [lo, hi] (snapped within tol), or the nearest copy outside."""
-    if lo <= x <= hi:
-        return x, True
-    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI
-    if y <= hi:
-        return y, True
-    if y <= hi + tol:
-        return hi, True
-    if y >= lo + TWO_PI - tol:
-        return lo, True
-    return (y, False) if y - hi <= lo + TWO_PI - y else (y - TWO_PI, False)
-
-
 @numba.njit(cache=True, nogil=True)
 def yaw(
     prm: np.ndarray, d0: float, d1: float, d2: float, theta: float, side: int, phi_ref: float

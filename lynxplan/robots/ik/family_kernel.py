@@ -17,6 +17,7 @@ import math
 import numba
 import numpy as np
 
+from lynxplan.arm.ik_kernel import wrap_into_limits  # one implementation with the AL5's
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
 from lynxplan.robots.ik.family_geometry import (
@@ -25,7 +26,6 @@ from lynxplan.robots.ik.family_geometry import (
     MODE_POSE,
     TWO_PI,
     branch,
-    wrap_into_limits,
 )
 from lynxplan.robots.ik.family_polish import NEWTON_TOLERANCE, branch_orientation_error, polish
 from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms

@@ -1,0 +1,77 @@
+"""Typed results of the AL5's IK (one pose), and the selected-branch rule shared with
+``lynxplan.robots.results``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple, Protocol
+
+import numpy as np
+
+from lynxplan.exceptions import NoSolutionWithinLimitsError
+
+
+class Branch(Protocol):
+    """What the selection rule reads of a branch."""
+
+    @property
+    def q(self) -> np.ndarray: ...
+    @property
+    def branch(self) -> str: ...
+
+
+def selected_q(solutions: Sequence[Branch], selected: int | None) -> np.ndarray:
+    """q of the selected branch.
+
+    Raises:
+        NoSolutionWithinLimitsError: if no branch is selected (none within the joint limits).
+    """
+    if selected is None:
+        raise NoSolutionWithinLimitsError(
+            "IK: no branch is within the joint limits: "
+            + "; ".join(f"{s.branch} {np.degrees(s.q).round(3).tolist()} deg" for s in solutions)
+        )
+    return solutions[selected].q
+
+
+class IkSolution(NamedTuple):
+    """One IK branch, checked by forward kinematics.
+
+    Attributes:
+        q: Joint angles, shape (5,), in [rad] (read-only).
+        branch: Branch name, e.g. ``"front/elbow-up"``.
+        within_limits: Whether q is within the joint limits (after snapping).
+        position_error: ``|p_fk(q) - p_target|``, in [m].
+        orientation_error: Angle between the FK rotation and the target, in [rad].
+    """
+
+    q: np.ndarray
+    branch: str
+    within_limits: bool
+    position_error: float
+    orientation_error: float
+
+
+@dataclass(frozen=True)
+class IkResult:
+    """IK of one pose.
+
+    Attributes:
+        solutions: Every branch (four), in :data:`lynxplan.arm.ik.BRANCH_NAMES` order.
+        selected: Index of the chosen solution, or None if none is within limits.
+        orientation_residual: Angle between target and nearest reachable orientation, [rad].
+    """
+
+    solutions: tuple[IkSolution, ...]
+    selected: int | None
+    orientation_residual: float
+
+    @property
+    def q(self) -> np.ndarray:
+        """The selected solution, shape (5,), in [rad].
+
+        Raises:
+            NoSolutionWithinLimitsError: if no branch is within the joint limits.
+        """
+        return selected_q(self.solutions, self.selected)
