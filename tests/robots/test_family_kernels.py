@@ -50,14 +50,14 @@ def test_roll_terms_match_the_angle_form(so101: Robot, mode: int) -> None:
         g = _scratch(so101, pose, mode)
         for theta in np.linspace(-3.1, 3.1, 25):
             for side in (0, 1):
-                f, c, miss = roll_terms(family.packed, pose, g, mode, theta, side, 0.2, 0.3)
-                ref = roll_equation_reference(family.packed, pose, g, mode, theta, side, 0.2, 0.3)
-                assert abs(f - ref) <= EQUATION_AGREEMENT
+                problem = (family.packed, pose, g, mode, side, 0.2, 0.3)
+                f, c, miss = roll_terms(problem, theta)
+                assert abs(f - roll_equation_reference(problem, theta)) <= EQUATION_AGREEMENT
                 assert miss >= 0.0
-                assert abs(miss - lateral_miss(family.packed, pose, theta, side, 0.2)) <= 1e-15
+                assert abs(miss - lateral_miss(problem, theta)) <= 1e-15
                 if mode == MODE_POSE:
                     assert abs(f * f + c * c - 1.0) <= EQUATION_AGREEMENT
-                mismatch = roll_mismatch(family.packed, pose, g, mode, theta, side, 0.2, 0.3)
+                mismatch = roll_mismatch(problem, theta)
                 assert 0.0 <= mismatch <= np.pi
 
 

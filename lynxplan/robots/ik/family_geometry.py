@@ -17,6 +17,12 @@ import numpy as np
 from lynxplan.robots import family as F  # noqa: N812
 
 MODE_POSE, MODE_APPROACH, MODE_PITCH = 0, 1, 2
+#: One target and one side: (prm, target (4, 4), g (SCRATCH_ROWS, 4) the kernel's per-target
+#: scratch, mode, side 0/1, reference yaw phi_ref, reference pitch sum sum_ref), see
+#: ``family_kernel``.
+RollProblem = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float, float]
+#: One target on the exact chain: (prm, placements, axes, target, g, mode, pitch).
+ChainProblem = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, float]
 TWO_PI = 2.0 * math.pi
 
 
@@ -170,20 +176,10 @@ def two_link(prm: np.ndarray, x: float, y: float, elbow: int) -> tuple[float, fl
 
 
 @numba.njit(cache=True, nogil=True)
-def branch(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    pitch: float,
-    theta: float,
-    side: int,
-    elbow: int,
-    phi_ref: float,
-    sum_ref: float,
-    out: np.ndarray,
-) -> float:
-    """Joint angles of one branch for roll theta into out (5,); returns the reach miss [m]."""
+def branch(problem: RollProblem, pitch: float, theta: float, elbow: int, out: np.ndarray) -> float:
+    """Joint angles of one branch (one side of ``problem``) for roll theta into out (5,);
+    pitch [rad] for pitch targets. Returns the reach miss [m]."""
+    prm, target, g, mode, side, phi_ref, sum_ref = problem
     d0, d1, d2 = (
         target[0, 3] - prm[F.C1],
         target[1, 3] - prm[F.C1 + 1],

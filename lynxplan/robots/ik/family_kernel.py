@@ -132,14 +132,14 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
             miss_out[n, b] = np.nan
             for j in range(5):
                 q_out[n, b, j] = np.nan
+        chain_problem = (prm, placements, axes, target, g, mode, pitch[n])
         for side in range(2):
+            problem = (prm, target, g, mode, side, phi_ref, sum_ref)
             count = 1
             roots[0] = theta_fixed
             rooted = True
             if need_roots:
-                count = roll_candidates(
-                    prm, target, g, mode, side, phi_ref, sum_ref, lo5, hi5, roots, grid_x, grid_f
-                )
+                count = roll_candidates(problem, lo5, hi5, roots, grid_x, grid_f)
                 if count < 0:  # no root: the nearest roll, held during the polish
                     count, rooted = 1, False
                     nearest = roots[0]
@@ -151,28 +151,13 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
             for ri in range(count):
                 for elbow in range(2):
                     b = side * per_side + ri * 2 + elbow
-                    miss = branch(
-                        prm, target, g, mode, pitch[n], roots[ri], side, elbow, phi_ref, sum_ref, q
-                    )
+                    miss = branch(problem, pitch[n], roots[ri], elbow, q)
                     polished = False
                     hold = False
                     if need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
                         # a tentative root: a branch only if Newton converges on the exact model
                         if (
-                            polish(
-                                prm,
-                                placements,
-                                axes,
-                                target,
-                                g,
-                                mode,
-                                pitch[n],
-                                np.nan,
-                                q,
-                                scratch,
-                                scratch4,
-                                scratch5,
-                            )
+                            polish(chain_problem, np.nan, q, scratch, scratch4, scratch5)
                             >= NEWTON_TOLERANCE
                         ):
                             firm = 0
@@ -181,57 +166,20 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                             if firm > 0:
                                 continue
                             # only tentative roots on this side: keep the nearest, roll held
-                            miss = branch(
-                                prm,
-                                target,
-                                g,
-                                mode,
-                                pitch[n],
-                                roots[ri],
-                                side,
-                                elbow,
-                                phi_ref,
-                                sum_ref,
-                                q,
-                            )
+                            miss = branch(problem, pitch[n], roots[ri], elbow, q)
                             hold = True
                         else:
                             polished = True
                     elif not exact and not rooted:
                         trial[:] = q
                         if (
-                            polish(
-                                prm,
-                                placements,
-                                axes,
-                                target,
-                                g,
-                                mode,
-                                pitch[n],
-                                np.nan,
-                                trial,
-                                scratch,
-                                scratch4,
-                                scratch5,
-                            )
+                            polish(chain_problem, np.nan, trial, scratch, scratch4, scratch5)
                             < NEWTON_TOLERANCE
                         ):
                             q[:] = trial
                             polished = True
                         else:
-                            miss = branch(
-                                prm,
-                                target,
-                                g,
-                                mode,
-                                pitch[n],
-                                nearest,
-                                side,
-                                elbow,
-                                phi_ref,
-                                sum_ref,
-                                q,
-                            )
+                            miss = branch(problem, pitch[n], nearest, elbow, q)
                     if not exact and not polished:
                         rg = roll_given
                         if math.isnan(rg) and (
@@ -241,20 +189,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                             or hold
                         ):
                             rg = q[4]
-                        polish(
-                            prm,
-                            placements,
-                            axes,
-                            target,
-                            g,
-                            mode,
-                            pitch[n],
-                            rg,
-                            q,
-                            scratch,
-                            scratch4,
-                            scratch5,
-                        )
+                        polish(chain_problem, rg, q, scratch, scratch4, scratch5)
                     inside = True
                     for j in range(5):
                         x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)

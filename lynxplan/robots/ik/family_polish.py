@@ -14,7 +14,13 @@ import numpy as np
 
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
-from lynxplan.robots.ik.family_geometry import MODE_APPROACH, MODE_PITCH, MODE_POSE, rotate
+from lynxplan.robots.ik.family_geometry import (
+    MODE_APPROACH,
+    MODE_PITCH,
+    MODE_POSE,
+    ChainProblem,
+    rotate,
+)
 
 #: Newton iterations at most, and the largest condition at which it stops.
 NEWTON_STEPS = 40
@@ -74,20 +80,16 @@ def lu_solve(lu: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
 
 @numba.njit(cache=True, nogil=True)
 def conditions(
-    prm: np.ndarray,
-    placements: np.ndarray,
-    axes: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    pitch: float,
+    problem: ChainProblem,
     roll_given: float,
     q: np.ndarray,
     pose: np.ndarray,
     work: np.ndarray,
     e: np.ndarray,
 ) -> None:
-    """The five conditions the branch satisfies, evaluated on the exact chain."""
+    """The five conditions the branch satisfies, evaluated on the exact chain into e (5,);
+    pose and work: scratch (4, 4)."""
+    prm, placements, axes, target, g, mode, pitch = problem
     chain_fk(placements, axes, q, pose, work)
     for i in range(3):
         e[i] = pose[i, 3] - target[i, 3]
@@ -137,13 +139,7 @@ def conditions(
 
 @numba.njit(cache=True, nogil=True)
 def polish(
-    prm: np.ndarray,
-    placements: np.ndarray,
-    axes: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    pitch: float,
+    problem: ChainProblem,
     roll_given: float,
     q: np.ndarray,
     scratch: np.ndarray,
@@ -163,7 +159,7 @@ def polish(
     step = scratch[5]
     jac = scratch5
     start[:] = q
-    conditions(prm, placements, axes, target, g, mode, pitch, roll_given, q, pose, work, e)
+    conditions(problem, roll_given, q, pose, work, e)
     first = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
     norm = first
     factored = fresh = False
@@ -174,9 +170,7 @@ def polish(
             for j in range(5):
                 qh[:] = q
                 qh[j] += _FD_STEP
-                conditions(
-                    prm, placements, axes, target, g, mode, pitch, roll_given, qh, pose, work, e2
-                )
+                conditions(problem, roll_given, qh, pose, work, e2)
                 for i in range(5):
                     jac[i, j] = (e2[i] - e[i]) / _FD_STEP
             if not lu_factor(jac):
@@ -190,9 +184,7 @@ def polish(
         for _ in range(12):
             for j in range(5):
                 qt[j] = q[j] - t * step[j]
-            conditions(
-                prm, placements, axes, target, g, mode, pitch, roll_given, qt, pose, work, e2
-            )
+            conditions(problem, roll_given, qt, pose, work, e2)
             trial = max(abs(e2[0]), abs(e2[1]), abs(e2[2]), abs(e2[3]), abs(e2[4]))
             if trial < norm:
                 q[:] = qt

@@ -19,6 +19,7 @@ import numpy as np
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
+    RollProblem,
     best_roll,
     pitch_sum,
     yaw,
@@ -30,20 +31,12 @@ _DEGENERATE = 1e-12
 
 
 @numba.njit(cache=True, nogil=True)
-def roll_equation_reference(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    theta: float,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
-) -> float:
+def roll_equation_reference(problem: RollProblem, theta: float) -> float:
     """The scalar whose roots are the rolls of an off-axis tool (one side), with angles.
 
     ``g[:, :3]`` is G = Rt Rt0^T, ``g[:, 3]`` the target approach axis.
     """
+    prm, target, g, mode, side, phi_ref, sum_ref = problem
     d0, d1, d2 = (
         target[0, 3] - prm[F.C1],
         target[1, 3] - prm[F.C1 + 1],
@@ -58,17 +51,9 @@ def roll_equation_reference(
 
 
 @numba.njit(cache=True, nogil=True)
-def _reference_terms(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    theta: float,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
-) -> tuple[float, float, float]:
+def _reference_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]:
     """``roll_terms`` with angles (the degenerate targets)."""
+    prm, target, g, mode, side, phi_ref, sum_ref = problem
     d0, d1, d2 = (
         target[0, 3] - prm[F.C1],
         target[1, 3] - prm[F.C1 + 1],
@@ -127,25 +112,17 @@ def _turn(
 
 
 @numba.njit(cache=True, nogil=True)
-def roll_terms(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    theta: float,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
-) -> tuple[float, float, float]:
+def roll_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]:
     """(f, c, lateral miss) at roll theta: f the roll equation; for full poses f and c are the
     sine and cosine of the best-roll mismatch (c = 1 for approach targets); the lateral miss
     [m] > 0 where the yaw circle is out of reach (the yaw is clamped there).
 
     ``g`` holds the target's constants (``prepare_roll_terms``).
     """
+    prm, _, g, mode, side, _, _ = problem
     rho = g[3, 0]
     if rho <= _DEGENERATE:
-        return _reference_terms(prm, target, g, mode, theta, side, phi_ref, sum_ref)
+        return _reference_terms(problem, theta)
     ct, st = math.cos(theta), math.sin(theta)
     lat = prm[F.LAM4] + prm[F.W0 + 2] + ct * prm[F.E1 + 2] + st * prm[F.E2 + 2]
     # yaw phi = alpha -+ beta, alpha = atan2(dh, dp), beta = acos(lat / rho) (see ``yaw``)
@@ -166,7 +143,7 @@ def roll_terms(
     in_h = cphi * ah - sphi * ap
     norm = math.sqrt(in_h * in_h + ak * ak)
     if norm <= _DEGENERATE:  # approach along the pitch axis: the reference pitch sum
-        return _reference_terms(prm, target, g, mode, theta, side, phi_ref, sum_ref)
+        return _reference_terms(problem, theta)
     # pitch sum Phi = atan2(ak, in_h) - gamma0
     cg, sg = g[4, 2], g[4, 3]
     cbig, sbig = (in_h * cg + ak * sg) / norm, (ak * cg - in_h * sg) / norm
@@ -190,43 +167,25 @@ def roll_terms(
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def roll_equation(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    theta: float,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
-) -> float:
+def roll_equation(problem: RollProblem, theta: float) -> float:
     """The scalar whose roots are the rolls of an off-axis tool (one side)."""
-    return roll_terms(prm, target, g, mode, theta, side, phi_ref, sum_ref)[0]
+    return roll_terms(problem, theta)[0]
 
 
 @numba.njit(cache=True, nogil=True)
-def roll_mismatch(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    theta: float,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
-) -> float:
+def roll_mismatch(problem: RollProblem, theta: float) -> float:
     """|wrapped best-roll difference| (pose) or |out-of-plane approach| (approach)."""
-    f, c, _ = roll_terms(prm, target, g, mode, theta, side, phi_ref, sum_ref)
+    mode = problem[3]
+    f, c, _ = roll_terms(problem, theta)
     if mode == MODE_APPROACH:
         return abs(f)
     return abs(math.atan2(f, c))
 
 
 @numba.njit(cache=True, nogil=True)
-def lateral_miss(
-    prm: np.ndarray, target: np.ndarray, theta: float, side: int, phi_ref: float
-) -> float:
+def lateral_miss(problem: RollProblem, theta: float) -> float:
     """By how much the tool point misses the yaw circle at roll theta [m] (0 within reach)."""
+    prm, target, _, _, side, phi_ref, _ = problem
     d0 = target[0, 3] - prm[F.C1]
     d1 = target[1, 3] - prm[F.C1 + 1]
     d2 = target[2, 3] - prm[F.C1 + 2]

@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from lynxplan.robots import family as F  # noqa: N812
-from lynxplan.robots.ik.family_geometry import MODE_APPROACH
+from lynxplan.robots.ik.family_geometry import MODE_APPROACH, RollProblem
 from lynxplan.robots.ik.roll_equation import (
     lateral_miss,
     roll_equation,
@@ -49,13 +49,7 @@ _BRENT_RELATIVE, _BRENT_ABSOLUTE = 1.5e-8, 1e-11
 
 @numba.njit(cache=True, nogil=True)
 def _refine_root(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
+    problem: RollProblem,
     a: float,
     fa: float,
     b: float,
@@ -67,7 +61,7 @@ def _refine_root(
         c = (a * fb - b * fa) / (fb - fa)
         if not (min(a, b) <= c <= max(a, b)):
             c = 0.5 * (a + b)
-        fc = roll_equation(prm, target, g, mode, c, side, phi_ref, sum_ref)
+        fc = roll_equation(problem, c)
         if fc == 0.0 or abs(b - a) < 1e-15:
             return c
         if (fc > 0) == (fb > 0):
@@ -87,13 +81,7 @@ def _refine_root(
 
 @numba.njit(cache=True, nogil=True)
 def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
+    problem: RollProblem,
     a: float,
     b: float,
     sign: float,
@@ -102,7 +90,7 @@ def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
     fallback), or the first point found where sign * f < 0 (then f changes sign in [a, b])."""
     golden = 0.5 * (3.0 - math.sqrt(5.0))
     x = w = v = a + golden * (b - a)
-    fx = sign * roll_equation(prm, target, g, mode, x, side, phi_ref, sum_ref)
+    fx = sign * roll_equation(problem, x)
     if fx < 0.0:
         return x
     fw = fv = fx
@@ -134,7 +122,7 @@ def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
             e = (a - x) if x >= xm else (b - x)
             d = golden * e
         u = x + d if abs(d) >= tol1 else x + (tol1 if d > 0 else -tol1)
-        fu = sign * roll_equation(prm, target, g, mode, u, side, phi_ref, sum_ref)
+        fu = sign * roll_equation(problem, u)
         if fu < 0.0:
             return u
         if fu <= fx:
@@ -157,22 +145,16 @@ def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
 
 @numba.njit(cache=True, nogil=True)
 def _keep_root(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
+    problem: RollProblem,
     x: float,
     roots: np.ndarray,
     count: int,
 ) -> int:
     """Store root x unless it is a spurious one (best roll opposite, sin = 0 at pi)."""
-    f, c, lateral_miss = roll_terms(prm, target, g, mode, x, side, phi_ref, sum_ref)
-    if mode != MODE_APPROACH and abs(math.atan2(f, c)) > 0.5 * math.pi:
+    f, c, miss = roll_terms(problem, x)
+    if problem[3] != MODE_APPROACH and abs(math.atan2(f, c)) > 0.5 * math.pi:
         return count
-    if lateral_miss > CLAMPED_ROOT_TOLERANCE:  # the yaw is clamped there: not a solution
+    if miss > CLAMPED_ROOT_TOLERANCE:  # the yaw is clamped there: not a solution
         return count
     if count < MAX_ROOTS:
         roots[count] = x
@@ -183,13 +165,7 @@ def _keep_root(
 
 @numba.njit(cache=True, nogil=True)
 def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
+    problem: RollProblem,
     lo: float,
     hi: float,
     roots: np.ndarray,
@@ -209,19 +185,19 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
     step = (hi - lo) / ROOT_GRID
     m = 0
     xs[0] = lo
-    f0, _, miss0 = roll_terms(prm, target, g, mode, lo, side, phi_ref, sum_ref)
+    f0, _, miss0 = roll_terms(problem, lo)
     fs[0] = f0
     c0 = miss0 > 0.0
     for i in range(1, ROOT_GRID + 1):
         x0 = xs[m]
         x1 = lo + step * i if i < ROOT_GRID else hi
-        f1, _, miss1 = roll_terms(prm, target, g, mode, x1, side, phi_ref, sum_ref)
+        f1, _, miss1 = roll_terms(problem, x1)
         c1 = miss1 > 0.0
         if c0 != c1:
             a, b = x0, x1  # a keeps the state of x0
             for _ in range(60):
                 mid = 0.5 * (a + b)
-                if (lateral_miss(prm, target, mid, side, phi_ref) > 0.0) == c0:
+                if (lateral_miss(problem, mid) > 0.0) == c0:
                     a = mid
                 else:
                     b = mid
@@ -238,12 +214,12 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
                     continue
                 m += 1
                 xs[m] = x
-                fs[m] = roll_equation(prm, target, g, mode, x, side, phi_ref, sum_ref)
+                fs[m] = roll_equation(problem, x)
         elif abs(f1 - fs[m]) > FAST_CHANGE:
             for j in range(1, SUBDIVISION):
                 m += 1
                 xs[m] = x0 + (x1 - x0) * j / SUBDIVISION
-                fs[m] = roll_equation(prm, target, g, mode, xs[m], side, phi_ref, sum_ref)
+                fs[m] = roll_equation(problem, xs[m])
         m += 1
         xs[m], fs[m] = x1, f1
         c0 = c1
@@ -252,14 +228,14 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
         if count >= MAX_ROOTS:
             break
         if fs[i] == 0.0:
-            count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xs[i], roots, count)
+            count = _keep_root(problem, xs[i], roots, count)
             continue
         if i == m:
             break
         f0, f1 = fs[i], fs[i + 1]
         if f1 != 0.0 and (f0 < 0.0) != (f1 < 0.0):
-            x = _refine_root(prm, target, g, mode, side, phi_ref, sum_ref, xs[i], f0, xs[i + 1], f1)
-            count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+            x = _refine_root(problem, xs[i], f0, xs[i + 1], f1)
+            count = _keep_root(problem, x, roots, count)
         elif (
             i > 0
             and (fs[i - 1] < 0.0) == (f0 < 0.0)
@@ -268,41 +244,26 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
         ):
             # local extremum of |f| at grid point i: two roots may hide in [x_{i-1}, x_{i+1}]
             sign = 1.0 if f0 > 0 else -1.0
-            xm = _minimise(prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], xs[i + 1], sign)
-            fm = roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
+            xm = _minimise(problem, xs[i - 1], xs[i + 1], sign)
+            fm = roll_equation(problem, xm)
             if fm == 0.0:
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
+                count = _keep_root(problem, xm, roots, count)
             elif (fm < 0.0) == (f0 < 0.0) and abs(fm) <= TANGENT_TOLERANCE:
                 # a double (tangent) root: f touches zero without crossing it
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
-            elif prm[F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
+                count = _keep_root(problem, xm, roots, count)
+            elif problem[0][F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
                 # the exact model may have a close pair of roots here that the nearly
                 # identical ideal model lacks: tentative, kept only if Newton converges
                 for shift in (-2e-3, 2e-3):
                     before = count
-                    count = _keep_root(
-                        prm,
-                        target,
-                        g,
-                        mode,
-                        side,
-                        phi_ref,
-                        sum_ref,
-                        xm + shift,
-                        roots,
-                        count,
-                    )
+                    count = _keep_root(problem, xm + shift, roots, count)
                     if count > before:
                         roots[MAX_ROOTS + count - 1] = 1.0
             elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
-                x = _refine_root(
-                    prm, target, g, mode, side, phi_ref, sum_ref, xs[i - 1], fs[i - 1], xm, fm
-                )
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
-                x = _refine_root(
-                    prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[i + 1], f1
-                )
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+                x = _refine_root(problem, xs[i - 1], fs[i - 1], xm, fm)
+                count = _keep_root(problem, x, roots, count)
+                x = _refine_root(problem, xm, fm, xs[i + 1], f1)
+                count = _keep_root(problem, x, roots, count)
     # an extremum at either end of the range hides roots the scan above cannot see
     for lo_i, hi_i, end in ((0, 1, 0), (m - 1, m, m)):
         inner = 1 if end == 0 else m - 1
@@ -314,34 +275,24 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
             and abs(fs[end]) < abs(fs[inner])
         ):
             sign = 1.0 if fs[end] > 0 else -1.0
-            xm = _minimise(prm, target, g, mode, side, phi_ref, sum_ref, xs[lo_i], xs[hi_i], sign)
-            fm = roll_equation(prm, target, g, mode, xm, side, phi_ref, sum_ref)
+            xm = _minimise(problem, xs[lo_i], xs[hi_i], sign)
+            fm = roll_equation(problem, xm)
             if abs(fm) <= TANGENT_TOLERANCE:
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, xm, roots, count)
+                count = _keep_root(problem, xm, roots, count)
             elif (fm < 0.0) != (fs[end] < 0.0):
-                x = _refine_root(
-                    prm, target, g, mode, side, phi_ref, sum_ref, xs[lo_i], fs[lo_i], xm, fm
-                )
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
-                x = _refine_root(
-                    prm, target, g, mode, side, phi_ref, sum_ref, xm, fm, xs[hi_i], fs[hi_i]
-                )
-                count = _keep_root(prm, target, g, mode, side, phi_ref, sum_ref, x, roots, count)
+                x = _refine_root(problem, xs[lo_i], fs[lo_i], xm, fm)
+                count = _keep_root(problem, x, roots, count)
+                x = _refine_root(problem, xm, fm, xs[hi_i], fs[hi_i])
+                count = _keep_root(problem, x, roots, count)
     if count > 0:
         return count
-    roots[0] = _nearest_roll(prm, target, g, mode, side, phi_ref, sum_ref, xs, fs, m)
+    roots[0] = _nearest_roll(problem, xs, fs, m)
     return -1
 
 
 @numba.njit(cache=True, nogil=True)
 def _nearest_roll(
-    prm: np.ndarray,
-    target: np.ndarray,
-    g: np.ndarray,
-    mode: int,
-    side: int,
-    phi_ref: float,
-    sum_ref: float,
+    problem: RollProblem,
     xs: np.ndarray,
     fs: np.ndarray,
     m: int,
@@ -350,19 +301,17 @@ def _nearest_roll(
     section (fs is overwritten with the mismatch)."""
     best = 0
     for i in range(m + 1):
-        fs[i] = roll_mismatch(prm, target, g, mode, xs[i], side, phi_ref, sum_ref)
+        fs[i] = roll_mismatch(problem, xs[i])
         if fs[i] < fs[best]:
             best = i
     a, b = xs[max(best - 1, 0)], xs[min(best + 1, m)]
     inv = 0.5 * (math.sqrt(5.0) - 1.0)
     for _ in range(60):
         c, d = b - inv * (b - a), a + inv * (b - a)
-        if roll_mismatch(prm, target, g, mode, c, side, phi_ref, sum_ref) < roll_mismatch(
-            prm, target, g, mode, d, side, phi_ref, sum_ref
-        ):
+        if roll_mismatch(problem, c) < roll_mismatch(problem, d):
             b = d
         else:
             a = c
     xm = 0.5 * (a + b)
-    better = roll_mismatch(prm, target, g, mode, xm, side, phi_ref, sum_ref) < fs[best]
+    better = roll_mismatch(problem, xm) < fs[best]
     return xm if better else float(xs[best])
