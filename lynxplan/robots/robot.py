@@ -100,7 +100,7 @@ class Robot:
             self._arm = load_arm()
 
     # -- description ------------------------------------------------------------------------
-    @property
+    @cached_property
     def ik_solver(self) -> str:
         """Name of the IK solver this robot uses."""
         if self.family is None:

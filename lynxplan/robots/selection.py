@@ -31,28 +31,25 @@ def select_one(
     """The branches of the single target of ``batch``, the one nearest ``reference`` (n,) [rad]
     selected among those within the limits that reach the target (or come nearest)."""
     slots = np.flatnonzero(batch.valid[0])
-    solutions = []
-    for b in slots:
-        q = np.array(batch.q[0, b])
-        q.setflags(write=False)
-        solutions.append(
-            RobotIkSolution(
-                q,
-                batch.branch_names[b],
-                bool(batch.within_limits[0, b]),
-                float(batch.position_error[0, b]),
-                float(batch.orientation_error[0, b]),
-            )
+    q = np.array(batch.q[0, slots])  # fresh; each solution's q is a read-only row of it
+    q.setflags(write=False)
+    within = batch.within_limits[0, slots]
+    perr = batch.position_error[0, slots]
+    oerr = batch.orientation_error[0, slots].tolist()
+    names = batch.branch_names
+    solutions = [
+        RobotIkSolution(q[i], names[b], w, p, o)
+        for i, (b, w, p, o) in enumerate(
+            zip(slots.tolist(), within.tolist(), perr.tolist(), oerr, strict=True)
         )
+    ]
     if verify:
         verify_branches(robot, solutions)
-    best, best_cost = None, np.inf
-    for i, s in enumerate(solutions):
-        if not s.within_limits or s.position_error > batch.distance[0] + REACH_TOLERANCE:
-            continue
-        cost = float(np.sum((s.q - reference) ** 2))
-        if cost < best_cost:
-            best, best_cost = i, cost
+    eligible = within & (perr <= batch.distance[0] + REACH_TOLERANCE)
+    best = None
+    if eligible.any():
+        cost = np.where(eligible, ((q - reference) ** 2).sum(axis=1), np.inf)
+        best = int(np.argmin(cost))
     ranked = (
         best
         if best is not None

@@ -46,15 +46,20 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
     assert family is not None
     n = target.poses.shape[0]
     slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
-    q = np.full((n, slots, 5), np.nan)
-    valid = np.zeros((n, slots), dtype=np.bool_)
-    within = np.zeros((n, slots), dtype=np.bool_)
-    perr = np.full((n, slots), np.nan)
-    oerr = np.full((n, slots), np.nan)
-    rest = np.ones(n, dtype=np.bool_)
+    # the kernel writes every slot of the targets it solves (NaN / False where no branch)
+    q = np.empty((n, slots, 5))
+    valid = np.empty((n, slots), dtype=np.bool_)
+    within = np.empty((n, slots), dtype=np.bool_)
+    perr, oerr = np.empty((n, slots)), np.empty((n, slots))
+    rest = None
     if robot._arm is not None and target.kind != fk_.MODE_PITCH:
+        q.fill(np.nan)
+        valid.fill(False)
+        within.fill(False)
+        perr.fill(np.nan)
+        oerr.fill(np.nan)
         rest = ~_al5_fill(robot, target, reference, q, valid, within, perr, oerr)
-    if rest.all():
+    if rest is None or rest.all():
         _kernel(robot, target, reference, q, valid, within, perr, oerr)
     elif rest.any():
         sub = type(target)(
