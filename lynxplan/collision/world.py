@@ -1,8 +1,8 @@
 """The collision world: the arm's URDF collision primitives and the obstacles, built once.
 
-Every link primitive (box or cylinder of the URDF's ``<collision>`` elements, read through
-Pinocchio's GeometryModel) becomes one collision object when the world is built; a query only
-moves those objects (``setRotation``/``setTranslation``). The obstacles' objects never move.
+Every link primitive (box, cylinder or mesh hull of the URDF's ``<collision>`` elements, read
+through Pinocchio's GeometryModel) becomes one collision object when the world is built; a query
+only moves those objects (``setRotation``/``setTranslation``). The obstacles' objects never move.
 
 Two distance engines, both built once:
 
@@ -105,7 +105,7 @@ class CollisionWorld:
             array.setflags(write=False)
         if engine == "fcl":
             self._build_fcl()
-        shapes = [g.geometry for g in arm.collision_model.geometryObjects]
+        shapes = [p.shape for p in self.links]
         self._coal_link_poses = [coal.Transform3s() for _ in self.links]
         self._coal_obstacle_poses = [
             coal.Transform3s(np.asarray(o.rotation), o.centre) for o in self.obstacles

@@ -5,7 +5,8 @@ A scenario kind is one module of :mod:`lynxplan.scenarios` registered in
 
 - ``Input``: a :class:`ScenarioModel` subclass (validation only, never computation) whose
   ``metrics`` class variable declares the metrics ``run`` measures and their quantities;
-- ``run(scenario) -> KindOutput``: the computation, pure (writes no file);
+- ``run(scenario, *, quick) -> KindOutput``: the computation, pure (writes no file); ``quick``
+  skips work no expectation needs (the comparisons with peer time laws);
 - ``write_outputs(scenario, output, out_dir, *, quick) -> list[str]``: the artifacts (CSV, PNG,
   HTML) written into ``out_dir``, returned as paths relative to it.
 
@@ -244,7 +245,7 @@ class ScenarioKind(Protocol):
     NAME: str
     Input: type[ScenarioModel]
 
-    def run(self, scenario: Any) -> KindOutput: ...
+    def run(self, scenario: Any, *, quick: bool = False) -> KindOutput: ...
 
     def write_outputs(
         self, scenario: Any, output: KindOutput, out_dir: Path, *, quick: bool

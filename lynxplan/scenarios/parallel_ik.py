@@ -81,7 +81,7 @@ class Input(ScenarioModel):
         }
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Solve the IK, verify each mode by FK and by the Pinocchio closure."""
     from lynxplan.parallel.fk import pose_distance, solve_fk
     from lynxplan.parallel.ik import WORKING_MODES, solve_ik

@@ -83,7 +83,7 @@ class Input(ScenarioModel):
         }
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Compute each orientation's workspace."""
     from lynxplan.parallel.workspace import constant_orientation_workspace
 

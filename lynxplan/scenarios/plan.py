@@ -253,7 +253,7 @@ def plan_inputs(scenario: Input) -> PlanInputs:
     )
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Plan, verify, time-parameterise; measure limits and per-sample clearance (no files)."""
     import time
 

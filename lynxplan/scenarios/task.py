@@ -303,7 +303,7 @@ class Input(ScenarioModel):
 Scenario = Input
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Resolve the scenario (IK of the waypoints, the plan), sample, check, compare (no files)."""
     from lynxplan.progress import progress_bar
     from lynxplan.task.report import summary, task_details, task_metrics, task_notes
@@ -312,7 +312,7 @@ def run(scenario: Input) -> KindOutput:
 
     with progress_bar(f"task {scenario.name}".strip()) as progress:
         setup = resolve(scenario)
-        result = execute(scenario, setup, progress)
+        result = execute(scenario, setup, progress, compare=scenario.compare and not quick)
         progress(5, 5)
     return KindOutput(
         task_metrics(result),

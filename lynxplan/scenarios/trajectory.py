@@ -283,13 +283,13 @@ def _metrics(plan: Plan, reports: list[SegmentReport]) -> dict[str, Any]:
     }
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Build, sample and compare the plan (no files)."""
     plan = build(scenario)
     samples = plan.sample(scenario.sample_rate)
     reports = segment_reports(plan, samples)
     comparison = None
-    if scenario.compare:
+    if scenario.compare and not quick:
         from lynxplan.trajectory.retime import compare_plan
 
         comparison = compare_plan(plan, scenario.sample_rate)

@@ -60,7 +60,7 @@ class Input(ScenarioModel):
         return data
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Sample the workspace and measure it (no files)."""
     from lynxplan.arm.workspace import estimate_workspace, report_grid, tool_positions
     from lynxplan.progress import progress_bar

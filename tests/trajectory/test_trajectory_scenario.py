@@ -16,22 +16,27 @@ SHIPPED = ["free_motion.yaml", "straight_line.yaml"]
 
 
 @pytest.mark.parametrize("name", SHIPPED)
-def test_shipped_scenarios_run_and_hold_their_expectations(name: str, tmp_path: Path) -> None:
-    outcome = run_scenario(SCENARIOS / name, tmp_path, quick=True)
+def test_shipped_scenarios_run_and_hold_their_expectations(name: str) -> None:
+    outcome = run_scenario(SCENARIOS / name)  # not quick: with the ruckig/toppra comparison
     assert outcome.ok, outcome.failed_expectations
-    report = json.loads((tmp_path / "report.json").read_text())
-    segment = report["details"]["segments"][0]
+    segment = outcome.details["segments"][0]
     assert segment["tt"] == 3.0 and segment["ta"] == 1.0
     assert segment["limit_violation_samples"] == 0
     assert {"lspb", "lspb_auto", "toppra"} <= set(segment["comparison"])
-    assert report["details"]["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
+    assert outcome.details["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
 
 
-def test_free_motion_report_matches_the_lspb_formulas(tmp_path: Path) -> None:
-    run_scenario(SCENARIOS / "free_motion.yaml", tmp_path, quick=True)
-    stats = json.loads((tmp_path / "report.json").read_text())["details"]["segments"][0][
-        "comparison"
-    ]
+def test_quick_runs_skip_the_comparison_and_keep_the_metrics(tmp_path: Path) -> None:
+    full = run_scenario(SCENARIOS / "straight_line.yaml")
+    quick = run_scenario(SCENARIOS / "straight_line.yaml", tmp_path, quick=True)
+    assert quick.metrics == full.metrics
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert "comparison" not in report["details"]["segments"][0]
+    assert "plan_comparison" not in report["details"]
+
+
+def test_free_motion_report_matches_the_lspb_formulas() -> None:
+    stats = run_scenario(SCENARIOS / "free_motion.yaml").details["segments"][0]["comparison"]
     # dA / T with T = tt - ta = 2 s and dA / (T ta) for the report's example.
     delta = [1.2, 0.9, 0.68, 1.0, 0.0]
     assert stats["lspb"]["peak_velocity_rad_s"] == pytest.approx([d / 2 for d in delta], abs=1e-9)
