@@ -76,7 +76,7 @@ def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray]:
     if not type(shape).__name__.startswith("Convex"):
         shape.buildConvexHull(True, "Qt")
         shape = shape.convex
-    points = np.array([shape.points(i) for i in range(shape.num_points)], dtype=float)
+    points = np.array(shape.points(), dtype=float).reshape(-1, 3)
     if points.shape[0] < 4 or not np.isfinite(points).all():
         raise CollisionModelError(name, "mesh has no usable vertices for a convex hull")
     centre = (points.min(axis=0) + points.max(axis=0)) / 2.0
@@ -124,7 +124,7 @@ def link_primitive(
     elif kind.startswith(("BVHModel", "Convex")):
         shape, offset = _mesh_hull(shape, name)
         placement = placement @ offset
-        points = np.array([shape.points(i) for i in range(shape.num_points)], dtype=float)
+        points = np.array(shape.points(), dtype=float).reshape(-1, 3)
         kind, half = "mesh", np.abs(points).max(axis=0)
     else:
         raise CollisionModelError(name, f"shape {kind} is not supported (box, cylinder, mesh)")

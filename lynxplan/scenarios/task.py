@@ -5,7 +5,7 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
     kind: task
     name: pick and place
     units: {length: in, angle: deg}          # lengths in|mm|m, angles deg|rad
-    robot: {}                                # the shipped AL5; or {urdf: path/to.urdf}
+    robot: {}                                # the shipped AL5; {name: so101}; {urdf: .., tool: ..}
     sample_rate: 1000                        # [Hz]
     timing: {tt: 2.0, ta: 0.5}               # default of every segment [s]; or: auto
     limits: {acceleration: 450, jerk: 3400}  # per joint (scalar or 5 values), angle unit / s^n
@@ -32,9 +32,12 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
       min_clearance: ">= 0.2 in"      # comparator, number, unit (default: the file's unit)
       max_duration: "<= 30 s"
 
-Robots: task scenarios plan with the AL5's analytic IK, so the robot must have the AL5's joint
-structure (the shipped URDF or a variant with other link lengths or collision shapes). A robot of
-another structure is rejected at run time with a message saying so.
+Robots: the shipped AL5 (default; also any URDF of its joint structure, solved with its closed
+form), ``{name: so100}`` / ``{name: so101}`` or ``{urdf: path, tool: frame}`` of any 5-joint
+yaw-pitch-pitch-pitch-roll arm (closed-form / root-search IK of :func:`lynxplan.load_robot`, mesh
+collision geometry as convex hulls). A waypoint's ``ik: report`` is the AL5's branch rule; other
+robots take the branch nearest ``q_reference`` (default: zeros). ``scenarios/so101_writing.yaml``
+is the SO-101 example.
 
 Relative URDF paths are resolved from the current working directory.
 
