@@ -36,7 +36,9 @@ from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.scenarios.base import (
     SI_UNITS,
+    Finite,
     KindOutput,
+    Positive,
     Quantity,
     ScenarioModel,
     StrictModel,
@@ -58,8 +60,6 @@ from lynxplan.trajectory.plan import (
 from lynxplan.trajectory.retime import TOPPRA_LIMIT_SAFETY
 from lynxplan.units import angle_factor, length_factor
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 #: A per-joint limit: one value for every joint, or one value per joint (5).
 PerJoint = Positive | Annotated[list[Positive], Field(min_length=5, max_length=5)]
 
@@ -315,17 +315,10 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
 
 def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
     """``trajectory.csv`` and, unless quick, the plots."""
-    from lynxplan.scenarios.outputs import write_trajectory_csv
+    from lynxplan.scenarios.outputs import write_samples_csv
 
     plan, samples, comparison = output.payload
-    write_trajectory_csv(
-        out_dir / "trajectory.csv",
-        samples.t,
-        samples.q,
-        samples.qd,
-        samples.qdd,
-        samples.tool[:, :3, 3],
-    )
+    write_samples_csv(out_dir / "trajectory.csv", samples)
     if quick:
         return ["trajectory.csv"]
     return ["trajectory.csv", *_write_plots(scenario, plan, samples, comparison, out_dir)]
