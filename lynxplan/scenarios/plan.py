@@ -225,11 +225,11 @@ class PlanInputs:
 
 
 def plan_inputs(scenario: Input) -> PlanInputs:
-    """The planner inputs of a scenario (loads the robot)."""
-    from lynxplan.scenarios.robot import load_arm_robot
+    """The planner inputs of a scenario (loads the robot: the AL5 or any URDF robot)."""
+    from lynxplan.scenarios.robot import load_robot_entry
 
     return PlanInputs(
-        load_arm_robot(scenario.robot),
+        load_robot_entry(scenario.robot),
         _obstacles(scenario),
         np.array(scenario.start) * angle_factor(scenario.units.angle),
         _goal(scenario),
