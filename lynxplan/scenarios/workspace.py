@@ -67,20 +67,14 @@ class Input(ScenarioModel):
 def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Sample the workspace and measure it (no files): the AL5's planar envelope, or the
     sampled points of any other robot."""
+    from lynxplan.arm.model import Arm
     from lynxplan.arm.workspace import estimate_workspace, report_grid, tool_positions
-    from lynxplan.exceptions import LynxplanError
     from lynxplan.progress import progress_bar
-    from lynxplan.scenarios.robot import load_arm_robot
+    from lynxplan.scenarios.robot import load_robot_entry
 
-    ref = scenario.robot
-    if ref.tool is not None or ref.name not in (None, "al5"):
-        return _run_sampled(scenario)
-    try:
-        arm = load_arm_robot(ref)
-    except LynxplanError:
-        if ref.urdf is None:
-            raise
-        return _run_sampled(scenario)  # a URDF of another structure
+    arm = load_robot_entry(scenario.robot)
+    if not isinstance(arm, Arm):
+        return _run_sampled(scenario, arm)
     unit = scenario.units.length
     scale = length_factor(unit)
     with progress_bar("sampling workspace") as progress:
@@ -117,19 +111,11 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     return KindOutput(metrics, summary, details, payload=(estimate, grid))
 
 
-def _run_sampled(scenario: Input) -> KindOutput:
+def _run_sampled(scenario: Input, robot: Any) -> KindOutput:
     """Any robot of ``lynxplan.load_robot``: voxel volume, reach and height of sampled points."""
-    import lynxplan
-    from lynxplan.exceptions import LynxplanError, ScenarioValueError
     from lynxplan.progress import progress_bar
     from lynxplan.robots.workspace import sample_workspace
 
-    ref = scenario.robot
-    try:
-        robot = lynxplan.load_robot(ref.urdf or ref.name or "al5", tool=ref.tool)
-    except LynxplanError as exc:
-        key = ("robot", "urdf" if ref.urdf is not None else "name")
-        raise ScenarioValueError(key, str(exc), ref.urdf or ref.name) from exc
     unit = scenario.units.length
     scale = length_factor(unit)
     with progress_bar("sampling workspace") as progress:
