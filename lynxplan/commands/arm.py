@@ -153,12 +153,3 @@ def handle_ik(args: argparse.Namespace) -> int:
         return 0
     print_ik_branches(result, solutions, selected, units["angle"], branch_width=17)
     return 0
-    print(f"orientation residual: {result.orientation_residual:.3g} rad")
-    if not solutions:
-        print("no solution within the joint limits (use --all to list every branch)")
-    for k, solution in enumerate(solutions):
-        mark = "*" if k == selected else " "
-        angles = "  ".join(f"{v:10.4f}" for v in solution["q"])
-        flag = "" if solution["within_limits"] else "  (outside limits)"
-        print(f"{mark} {solution['branch']:<17} {angles} {units['angle']}{flag}")
-    return 0

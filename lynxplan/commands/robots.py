@@ -13,12 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from lynxplan.commands._output import (
-    ik_branch_rows,
-    parse_finite,
-    print_ik_branches,
-    print_json,
-)
+from lynxplan.commands._output import ik_branch_rows, parse_finite, print_ik_branches, print_json
 from lynxplan.exceptions import InputError
 from lynxplan.units import angle_factor, length_factor
 
