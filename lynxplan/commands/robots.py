@@ -44,8 +44,11 @@ def add_robot_options(parser: argparse.ArgumentParser) -> None:
 
 
 def wants_robot(args: argparse.Namespace) -> bool:
-    """Whether a command was given a robot (then it runs through lynxplan.robots)."""
-    return bool(getattr(args, "robot", None) or getattr(args, "urdf", None))
+    """Whether a command was given a robot or a tool frame (then it runs through
+    lynxplan.robots: a ``--tool`` of the AL5 is checked, never ignored)."""
+    return bool(
+        getattr(args, "robot", None) or getattr(args, "urdf", None) or getattr(args, "tool", None)
+    )
 
 
 def _load(args: argparse.Namespace) -> Any:

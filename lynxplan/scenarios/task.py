@@ -57,13 +57,17 @@ from typing_extensions import Self
 
 from lynxplan.scenarios.base import (
     SI_UNITS,
+    Finite,
     KindOutput,
+    Matrix3,
+    Positive,
     Quantity,
     RobotRef,
     ScenarioModel,
     StrictModel,
+    TargetEntry,
     Units,
-    check_target_form,
+    Vector3,
     located_error,
     scale_translation,
     scaled,
@@ -73,10 +77,6 @@ from lynxplan.units import angle_factor, length_factor
 
 NAME = "task"
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 PerJoint = Positive | Annotated[list[Positive], Field(min_length=5, max_length=5)]
 
 
@@ -144,17 +144,12 @@ class CylinderEntry(_Oriented):
 ObstacleEntry = Annotated[BoxEntry | SphereEntry | CylinderEntry, Field(discriminator="type")]
 
 
-class WaypointEntry(StrictModel):
+class WaypointEntry(TargetEntry):
     """A waypoint: joint angles, a 4x4 pose, or a position with an approach direction."""
 
     q: Annotated[list[Finite], Field(min_length=5, max_length=5)] | None = Field(
         None, description="Joint angles q1..q5, in the file's angle unit."
     )
-    pose: Annotated[list[list[Finite]], Field(min_length=3, max_length=4)] | None = Field(
-        None, description="Tool pose: 3 or 4 rows of 4 (translation in the file's length unit)."
-    )
-    position: Vector3 | None = Field(None, description="Tool point (with approach).")
-    approach: Vector3 | None = Field(None, description="Tool approach axis (z) direction.")
     ik: Literal["report", "nearest"] = Field(
         "report",
         description="IK branch: the report's rule (first within limits with q2 >= 0, q3 <= 0) "
@@ -163,11 +158,6 @@ class WaypointEntry(StrictModel):
     q_reference: Annotated[list[Finite], Field(min_length=5, max_length=5)] | None = Field(
         None, description="For ik: nearest and for q5 of a position + approach target."
     )
-
-    @model_validator(mode="after")
-    def _one_form(self) -> Self:
-        check_target_form(self)
-        return self
 
 
 class TimingEntry(StrictModel):
@@ -329,19 +319,12 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
 
 def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
     """``trajectory.csv`` and, unless quick, the plots and the meshcat HTML."""
-    from lynxplan.scenarios.outputs import write_trajectory_csv
+    from lynxplan.scenarios.outputs import write_samples_csv
     from lynxplan.task.run import html_name
 
     result = output.payload
     samples = result.samples
-    write_trajectory_csv(
-        out_dir / "trajectory.csv",
-        samples.t,
-        samples.q,
-        samples.qd,
-        samples.qdd,
-        samples.tool[:, :3, 3],
-    )
+    write_samples_csv(out_dir / "trajectory.csv", samples)
     written = ["trajectory.csv"]
     if quick:
         return written

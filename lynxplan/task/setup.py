@@ -8,13 +8,13 @@ schema error: file, key path (line), reason. This runs at run time, never during
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 import numpy as np
 
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import LynxplanError, ScenarioValueError
+from lynxplan.scenarios.robot import load_path_robot
 from lynxplan.units import angle_factor, length_factor
 from lynxplan.viz import WritingPlane
 
@@ -22,7 +22,6 @@ if TYPE_CHECKING:
     from lynxplan.arm.model import Arm
     from lynxplan.collision.obstacles import Obstacle
     from lynxplan.robots import Robot
-    from lynxplan.scenarios.base import RobotRef
     from lynxplan.scenarios.task import (
         BoxEntry,
         CylinderEntry,
@@ -77,7 +76,7 @@ def _resolve(scenario: Scenario) -> TaskSetup:
 
     length = length_factor(scenario.units.length)
     angle = angle_factor(scenario.units.angle)
-    arm, kinematics = load_robot(scenario.robot)
+    arm, kinematics = load_path_robot(scenario.robot)
     limits = _limits(scenario, arm, angle)
     obstacles = tuple(_obstacles(scenario, length, angle))
     waypoints = {
@@ -116,49 +115,6 @@ def _resolve(scenario: Scenario) -> TaskSetup:
         )
     plan = Plan(tuple(segments), limits, kinematics)
     return TaskSetup(arm, kinematics, obstacles, waypoints, path, limits, plan, plane)
-
-
-#: Joints of the arms a task scenario plans with (yaw, three pitches, roll).
-TASK_JOINTS = 5
-
-
-def load_robot(entry: RobotRef) -> tuple[Arm | Robot, PathKinematics]:
-    """The robot of the scenario and its kinematics: the AL5 (the shipped URDF, or a URDF of
-    its joint structure) with its closed-form kernels, or any robot of
-    :func:`lynxplan.load_robot` whose chain is a 5-joint yaw-pitch-pitch-pitch-roll arm.
-
-    Raises:
-        ScenarioValueError: naming the ``robot`` key when the robot cannot be loaded or used.
-    """
-    from lynxplan.arm.model import load_arm
-    from lynxplan.trajectory.kinematics import Al5Kinematics, RobotKinematics
-
-    key = ("robot", "urdf" if entry.urdf is not None else "name")
-    value = entry.urdf if entry.urdf is not None else entry.name
-    if entry.tool is None and entry.name in (None, "al5"):
-        try:
-            arm = load_arm(entry.urdf)
-            return arm, Al5Kinematics(arm.geometry)
-        except LynxplanError as exc:  # not the AL5's structure: a URDF robot, if a file at all
-            if entry.urdf is None or not Path(entry.urdf).is_file():
-                raise _InvalidError(key, str(exc), value) from exc
-    import lynxplan
-
-    try:
-        robot = lynxplan.load_robot(value or "al5", tool=entry.tool)
-    except LynxplanError as exc:
-        raise _InvalidError(key, str(exc), value) from exc
-    if robot.nq != TASK_JOINTS:
-        raise _InvalidError(
-            key,
-            f"robot {robot.name} has {robot.nq} joints; task scenarios plan with 5-joint "
-            "yaw-pitch-pitch-pitch-roll arms (al5, so100, so101)",
-            value,
-        )
-    try:
-        return robot, RobotKinematics(robot)
-    except LynxplanError as exc:
-        raise _InvalidError(key, str(exc), value) from exc
 
 
 def _limits(scenario: Scenario, arm: Arm | Robot, angle: float) -> MotionLimits:

@@ -36,6 +36,17 @@ class PathIk(NamedTuple):
     """Angle between the interpolated and the reached orientation (or approach), (m,), [rad]."""
 
 
+class PathTargets(NamedTuple):
+    """Tool targets along a path: full poses, or tool points with an approach pitch and a roll."""
+
+    poses: np.ndarray
+    """Target poses, shape (m, 4, 4), in [m] (only the translation when ``pitch`` is given)."""
+    pitch: np.ndarray | None = None
+    """Approach pitch, shape (m,), in [rad] (0: straight down), or None for full poses."""
+    roll: np.ndarray | None = None
+    """Roll joint angle, shape (m,), in [rad] (with ``pitch``)."""
+
+
 class PathKinematics(Protocol):
     """What the free and straight-line segments need from an arm."""
 
@@ -50,28 +61,11 @@ class PathKinematics(Protocol):
         (0: straight down)."""
         ...
 
-    def solve_poses(
-        self, poses: np.ndarray, q_before: np.ndarray, limits: MotionLimits, s: np.ndarray
+    def solve(
+        self, targets: PathTargets, q_before: np.ndarray, limits: MotionLimits, s: np.ndarray
     ) -> PathIk:
-        """IK of full poses (m, 4, 4) along a path from ``q_before`` (n,); ``s`` (m,) is the path
-        parameter of each pose (named in errors).
-
-        Raises:
-            PathNotFollowableError: a pose is out of reach.
-        """
-        ...
-
-    def solve_pitch_roll(
-        self,
-        positions: np.ndarray,
-        pitch: np.ndarray,
-        roll: np.ndarray,
-        q_before: np.ndarray,
-        limits: MotionLimits,
-        s: np.ndarray,
-    ) -> PathIk:
-        """IK of tool points (m, 3) [m] with an approach pitch (m,) and roll joint angle (m,)
-        [rad] along a path from ``q_before`` (n,) at path parameters ``s`` (m,).
+        """IK of the targets along a path from ``q_before`` (n,); ``s`` (m,) is the path
+        parameter of each target (named in errors).
 
         Raises:
             PathNotFollowableError: a target is out of reach.
@@ -140,31 +134,20 @@ class Al5Kinematics:
         q, branch = select_continuous(ik.q, ik.within_limits, np.asarray(q_before, dtype=float))
         return PathIk(q, branch, np.asarray(ik.orientation_error))
 
-    def solve_poses(
-        self, poses: np.ndarray, q_before: np.ndarray, limits: MotionLimits, s: np.ndarray
+    def solve(
+        self, targets: PathTargets, q_before: np.ndarray, limits: MotionLimits, s: np.ndarray
     ) -> PathIk:
-        return self._solve(poses, None, q_before, limits, s)
-
-    def solve_pitch_roll(
-        self,
-        positions: np.ndarray,
-        pitch: np.ndarray,
-        roll: np.ndarray,
-        q_before: np.ndarray,
-        limits: MotionLimits,
-        s: np.ndarray,
-    ) -> PathIk:
+        if targets.pitch is None:
+            return self._solve(targets.poses, None, q_before, limits, s)
         # The approach axis in the vertical plane through the tool point; the roll is q5 of
         # the reference (only the approach column of the pose is used: approach_only).
-        poses = np.zeros((len(positions), 4, 4))
-        poses[:, 3, 3] = 1.0
-        poses[:, :3, 3] = positions
-        azimuth = np.arctan2(positions[:, 1], positions[:, 0])
-        poses[:, 0, 2] = np.cos(azimuth) * np.sin(pitch)
-        poses[:, 1, 2] = np.sin(azimuth) * np.sin(pitch)
-        poses[:, 2, 2] = -np.cos(pitch)
-        reference = np.zeros((len(positions), 5))
-        reference[:, 4] = roll
+        poses = targets.poses.copy()
+        azimuth = np.arctan2(poses[:, 1, 3], poses[:, 0, 3])
+        poses[:, 0, 2] = np.cos(azimuth) * np.sin(targets.pitch)
+        poses[:, 1, 2] = np.sin(azimuth) * np.sin(targets.pitch)
+        poses[:, 2, 2] = -np.cos(targets.pitch)
+        reference = np.zeros((len(poses), 5))
+        reference[:, 4] = targets.roll
         return self._solve(poses, reference, q_before, limits, s)
 
     def nearest(self, pose: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.ndarray:
@@ -242,26 +225,20 @@ class RobotKinematics:
             previous = q[k]
         return PathIk(q, branch, residual)
 
-    def solve_poses(
-        self, poses: np.ndarray, q_before: np.ndarray, limits: MotionLimits, s: np.ndarray
+    def solve(
+        self, targets: PathTargets, q_before: np.ndarray, limits: MotionLimits, s: np.ndarray
     ) -> PathIk:
-        batch = self.robot.ik_batch(poses, q_reference=q_before)
-        return self._follow(batch, q_before, s)
-
-    def solve_pitch_roll(
-        self,
-        positions: np.ndarray,
-        pitch: np.ndarray,
-        roll: np.ndarray,
-        q_before: np.ndarray,
-        limits: MotionLimits,
-        s: np.ndarray,
-    ) -> PathIk:
-        batch = self.robot.ik_batch(
-            positions=positions, pitches=pitch, rolls=roll, q_reference=q_before
-        )
+        if targets.pitch is None:
+            batch = self.robot.ik_batch(targets.poses, q_reference=q_before)
+        else:
+            batch = self.robot.ik_batch(
+                positions=targets.poses[:, :3, 3],
+                pitches=targets.pitch,
+                rolls=targets.roll,
+                q_reference=q_before,
+            )
         return self._follow(batch, q_before, s)
 
     def nearest(self, pose: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.ndarray:
-        q: np.ndarray = self.solve_poses(pose[None], q_near, limits, np.ones(1)).q[0]
+        q: np.ndarray = self.solve(PathTargets(pose[None]), q_near, limits, np.ones(1)).q[0]
         return q

@@ -30,7 +30,7 @@ from lynxplan import guards
 from lynxplan.constants import PATH_GRID_POINTS
 from lynxplan.exceptions import InputError
 from lynxplan.trajectory.free import JointSamples, as_configuration, check_timing
-from lynxplan.trajectory.kinematics import Al5Kinematics, PathKinematics
+from lynxplan.trajectory.kinematics import Al5Kinematics, PathKinematics, PathTargets
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming, unit_lspb
 from lynxplan.trajectory.rotations import (
@@ -184,14 +184,12 @@ class LineSegment:
 def _solve_line(
     segment: LineSegment, s: np.ndarray, q_before: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    poses = segment.targets(s)
-    kinematics, limits = segment.kinematics, segment.limits
+    targets = PathTargets(segment.targets(s))
     if segment.mode == "consistent":
         pitch = segment.pitch[0] + s * (segment.pitch[1] - segment.pitch[0])
         roll = segment.roll[0] + s * (segment.roll[1] - segment.roll[0])
-        ik = kinematics.solve_pitch_roll(poses[:, :3, 3], pitch, roll, q_before, limits, s)
-    else:
-        ik = kinematics.solve_poses(poses, q_before, limits, s)
+        targets = PathTargets(targets.poses, pitch, roll)
+    ik = segment.kinematics.solve(targets, q_before, segment.limits, s)
     return ik.q, ik.branch, ik.residual
 
 

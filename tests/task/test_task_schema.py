@@ -167,7 +167,7 @@ def test_robot_outside_the_five_joint_family_is_rejected_at_run_time(tmp_path):
 
     ur5 = "ur_description/urdf/ur5_robot.urdf"
     data = scenario_dict(robot={"urdf": f"{getModelPath(ur5)}/{ur5}", "tool": "tool0"})
-    with pytest.raises(ScenarioError, match=r"robot\.urdf: robot .* has 6 joints; task scenarios"):
+    with pytest.raises(ScenarioError, match=r"robot\.urdf: robot .* has 6 joints; task and"):
         _load(tmp_path, data)
     with pytest.raises(ScenarioError, match=r"robot\.name: unknown robot 'so102'"):
         _load(tmp_path, scenario_dict(robot={"name": "so102"}))
