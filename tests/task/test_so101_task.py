@@ -80,3 +80,18 @@ def test_clearance_is_exact_on_hulls_and_safe_for_the_meshes(run) -> None:
     )
     assert worst.clearance <= mesh_distance + DISTANCE_TOL
     assert worst.clearance >= 0.015  # the scenario's expectation, measured 20.2 mm
+
+
+def test_a_planned_pen_up_move_of_the_so101(tmp_path) -> None:
+    import yaml
+
+    from lynxplan.scenarios import run_scenario
+
+    data = yaml.safe_load(SO101_TASK.read_text())
+    for segment in data["segments"]:
+        if segment["to"] == "K1_up":
+            segment["motion"] = "plan"  # between the letters: planned, verified with coal
+    result = run_scenario(data, tmp_path / "out", quick=True)
+    assert result.ok, result.failed_expectations
+    assert result.metrics["collision_free"] is True
+    assert result.metrics["min_clearance"] >= 0.015
