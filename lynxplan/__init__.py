@@ -6,16 +6,9 @@
 
 from __future__ import annotations
 
-from importlib.metadata import PackageNotFoundError, version
 from typing import TYPE_CHECKING, Any
 
 from lynxplan.exceptions import LynxplanError
-
-try:
-    #: The installed distribution's version (pyproject.toml is the one place it is written).
-    __version__ = version("lynxplan")
-except PackageNotFoundError:  # a source tree on sys.path without an installed distribution
-    __version__ = "0+unknown"
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm, load_arm
@@ -37,8 +30,16 @@ __all__ = [
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy attributes: ``load_arm``, ``Arm``, ``load_robot``, ``Robot``, ``run_scenario``,
-    ``plan``, ``PlannedTrajectory``."""
+    """Lazy attributes: ``__version__`` (the installed distribution's, read from its metadata:
+    pyproject.toml is the one place it is written), ``load_arm``, ``Arm``, ``load_robot``,
+    ``Robot``, ``run_scenario``, ``plan``, ``PlannedTrajectory``."""
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            return version("lynxplan")
+        except PackageNotFoundError:  # a source tree on sys.path, no installed distribution
+            return "0+unknown"
     if name in ("load_arm", "Arm"):
         from lynxplan.arm import model
 

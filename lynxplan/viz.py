@@ -1,8 +1,9 @@
 """meshcat scene of a motion, exported as one self-contained static HTML file.
 
-The arm is drawn from its URDF visual geometry (boxes and cylinders with the URDF material
-colours), the obstacles as semi-transparent orange solids, an optional writing plane, the pen
-path as polylines coloured by motion type, and the whole motion as a meshcat animation.
+The arm is drawn from its URDF visual geometry (boxes, cylinders and STL/OBJ/DAE meshes with the
+URDF material colours), the obstacles as semi-transparent orange solids, an optional writing
+plane, the pen path as polylines coloured by motion type, and the whole motion as a meshcat
+animation.
 
 meshcat is imported only here, inside the functions. ``meshcat.Visualizer()`` starts a ZMQ server
 as a child process; :func:`export_html` always stops it before returning.
@@ -85,17 +86,32 @@ def _hex(rgba: np.ndarray) -> int:
     return (r << 16) | (g << 8) | b
 
 
-def _geometry_and_offset(shape: Any) -> tuple[Any, np.ndarray]:
+#: meshcat geometry class of each mesh file suffix.
+_MESH_FILES = {".stl": "StlMeshGeometry", ".obj": "ObjMeshGeometry", ".dae": "DaeMeshGeometry"}
+
+
+def _geometry_and_offset(geometry_object: Any) -> tuple[Any, np.ndarray]:
+    """meshcat geometry of a visual GeometryObject and its offset (4, 4) in the object's frame
+    (a mesh's scale; meshcat's cylinder axis)."""
     import meshcat.geometry as mg
 
+    shape = geometry_object.geometry
     kind = type(shape).__name__
+    mesh_path = Path(str(getattr(geometry_object, "meshPath", "") or ""))
+    if mesh_path.suffix.lower() in _MESH_FILES and mesh_path.is_file():
+        mesh = getattr(mg, _MESH_FILES[mesh_path.suffix.lower()]).from_file(str(mesh_path))
+        scale = np.eye(4)
+        scale[:3, :3] = np.diag(np.asarray(geometry_object.meshScale, dtype=float))
+        return mesh, scale
     if kind == "Box":
         return mg.Box((2.0 * np.asarray(shape.halfSide)).tolist()), np.eye(4)
     if kind == "Cylinder":
         return mg.Cylinder(2.0 * shape.halfLength, shape.radius), _Y_TO_Z
     if kind == "Sphere":
         return mg.Sphere(shape.radius), np.eye(4)
-    raise InputError(f"visual geometry of type {kind} cannot be drawn (box, cylinder, sphere)")
+    raise InputError(
+        f"visual geometry of type {kind} cannot be drawn (box, cylinder, sphere, STL/OBJ/DAE mesh)"
+    )
 
 
 def _obstacle_geometry(obstacle: Obstacle) -> tuple[Any, np.ndarray]:
@@ -216,7 +232,7 @@ def export_html(
         vis["/Axes"].set_property("visible", False)
         offsets = []
         for v, geometry_object in enumerate(visual):
-            shape, offset = _geometry_and_offset(geometry_object.geometry)
+            shape, offset = _geometry_and_offset(geometry_object)
             material = mg.MeshLambertMaterial(color=_hex(geometry_object.meshColor))
             vis["arm"][geometry_object.name].set_object(shape, material)
             vis["arm"][geometry_object.name].set_transform(poses[0, v] @ offset)

@@ -1,14 +1,17 @@
 """Bench section ``cold``: fresh-process start-up of the commands users type first.
 
-Each command runs in a new Python process (after one untimed run that fills the numba and OS
-caches, so "cold" means a new process, not a cold disk): ``lynxplan fk``, ``lynxplan run
-scenarios/ok_task.yaml --quick`` and, as the yardstick of the machine, ``python -c 'import
-pinocchio'``. Figures are medians of wall time and of the child's CPU time (user + system, less
-sensitive to a shared machine), and each command's ratio to the pinocchio import.
+Each command runs in a new Python process (after one untimed run that fills the numba, bytecode
+and OS caches, so "cold" means a new process, not a cold disk; ``PYTHONDONTWRITEBYTECODE`` is
+dropped for the children, as an installed package has its ``.pyc`` files): ``lynxplan fk``,
+``lynxplan run scenarios/ok_task.yaml --quick`` and, as the yardstick of the machine,
+``python -c 'import pinocchio'``. Figures are medians of wall time and of the child's CPU time
+(user + system, less sensitive to a shared machine), and each command's ratio to the pinocchio
+import.
 """
 
 from __future__ import annotations
 
+import os
 import resource
 import statistics
 import subprocess
@@ -46,9 +49,10 @@ def time_command(command: list[str]) -> tuple[float, float]:
     Raises:
         RuntimeError: the command failed (its last stderr line is quoted).
     """
+    env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
-    done = subprocess.run(command, capture_output=True, text=True, check=False)
+    done = subprocess.run(command, capture_output=True, text=True, check=False, env=env)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
     if done.returncode != 0:

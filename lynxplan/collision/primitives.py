@@ -1,6 +1,12 @@
-"""The arm's collision primitives (boxes, cylinders) with their covering spheres and joint reach,
-and the obstacles' arrays and signed distance for the vectorised lower bound (see
-:mod:`lynxplan.collision.world`)."""
+"""The arm's collision primitives (boxes, cylinders, meshes) with their covering spheres and joint
+reach, and the obstacles' arrays and signed distance for the vectorised lower bound (see
+:mod:`lynxplan.collision.world`).
+
+A mesh (a URDF ``<mesh>`` collision element, e.g. the SO-101's STL parts) is replaced by its
+convex hull (coal's qhull), expressed in the frame of the hull's axis-aligned bounding box: exact
+distances are taken to the hull, never more than the distance to the mesh itself (the safe side
+for a clearance), and the covering spheres cover the bounding box like a box primitive's.
+"""
 
 from __future__ import annotations
 
@@ -26,12 +32,15 @@ class LinkPrimitive:
         link: Name of the URDF link carrying it, e.g. ``"gripper"``.
         joint: Index of the Pinocchio joint that moves it (0: fixed to the base).
         placement: Pose in the joint frame, shape (4, 4), in [m].
-        kind: ``"box"`` or ``"cylinder"``.
-        half_extents: Box half sizes (3,), or (radius, half length, 0) of a cylinder, in [m].
+        kind: ``"box"``, ``"cylinder"`` or ``"mesh"`` (its convex hull, inside the box of
+            ``half_extents`` centred on the primitive frame).
+        half_extents: Box (or a mesh's bounding box) half sizes (3,), or (radius, half length, 0)
+            of a cylinder, in [m].
         sphere_centres: Covering sphere centres in the primitive frame, shape (K, 3), in [m].
         sphere_radius: Radius of every covering sphere, in [m].
         reach: Upper bound of the distance of any point of the primitive from the axis of each
             joint (shape (nq,), in [m]; 0 for joints that do not move it).
+        shape: The coal geometry of exact distances, in the primitive frame.
     """
 
     geometry: str
@@ -43,6 +52,7 @@ class LinkPrimitive:
     sphere_centres: np.ndarray
     sphere_radius: float
     reach: np.ndarray
+    shape: Any = None
 
 
 def joint_structure(model: Any) -> tuple[list[tuple[int, int]], list[np.ndarray]]:
@@ -58,36 +68,68 @@ def joint_structure(model: Any) -> tuple[list[tuple[int, int]], list[np.ndarray]
     return axes, placements
 
 
+def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray]:
+    """Convex hull of a mesh (coal BVH or Convex) centred on its bounding box, and the offset
+    (4, 4) of that frame in the geometry frame."""
+    import coal
+
+    if not type(shape).__name__.startswith("Convex"):
+        shape.buildConvexHull(True, "Qt")
+        shape = shape.convex
+    points = np.array(shape.points(), dtype=float).reshape(-1, 3)
+    if points.shape[0] < 4 or not np.isfinite(points).all():
+        raise CollisionModelError(name, "mesh has no usable vertices for a convex hull")
+    centre = (points.min(axis=0) + points.max(axis=0)) / 2.0
+    shifted = coal.StdVec_Vec3s()
+    shifted.extend(list(points - centre))
+    hull = coal.Convex.convexHull(shifted, False, "Qt")
+    offset = np.eye(4)
+    offset[:3, 3] = centre
+    return hull, offset
+
+
+def _cover(kind: str, half: np.ndarray) -> tuple[np.ndarray, float]:
+    """Covering sphere centres (K, 3) and radius of a box ``half`` (3,) or a cylinder
+    ``(radius, half length, 0)``, cut into pieces along the longest axis."""
+    if kind == "cylinder":
+        radius, half_length = float(half[0]), float(half[1])
+        longest, length = 2, half_length
+        pieces = max(1, math.ceil(half_length / radius))
+    else:
+        longest = int(np.argmax(half))
+        length = float(half[longest])
+        second = float(np.sort(half)[-2])
+        pieces = max(1, math.ceil(length / second)) if second > 0 else 1
+    piece_half = length / pieces
+    centres = np.zeros((pieces, 3))
+    centres[:, longest] = -length + piece_half * (2 * np.arange(pieces) + 1)
+    if kind == "cylinder":
+        return centres, math.hypot(float(half[0]), piece_half)
+    sub = half.copy()
+    sub[longest] = piece_half
+    return centres, float(np.linalg.norm(sub))
+
+
 def link_primitive(
     model: Any, geometry_object: Any, joint_placements: list[np.ndarray]
 ) -> LinkPrimitive:
     shape = geometry_object.geometry
     kind = type(shape).__name__
     name = geometry_object.name
-    if kind == "Box":
-        half = np.array(shape.halfSide, dtype=float)
-        longest = int(np.argmax(half))
-        second = float(np.sort(half)[-2])
-        pieces = max(1, math.ceil(half[longest] / second))
-        bounding = float(np.linalg.norm(half))
-    elif kind == "Cylinder":
-        half = np.array([shape.radius, shape.halfLength, 0.0])
-        longest = 2
-        pieces = max(1, math.ceil(shape.halfLength / shape.radius))
-        bounding = math.hypot(shape.radius, shape.halfLength)
-    else:
-        raise CollisionModelError(name, f"shape {kind} is not supported (box or cylinder)")
-    length = half[longest] if kind == "Box" else shape.halfLength
-    piece_half = length / pieces
-    centres = np.zeros((pieces, 3))
-    centres[:, longest] = -length + piece_half * (2 * np.arange(pieces) + 1)
-    if kind == "Box":
-        sub = half.copy()
-        sub[longest] = piece_half
-        radius = float(np.linalg.norm(sub))
-    else:
-        radius = math.hypot(shape.radius, piece_half)
     placement = np.array(geometry_object.placement.homogeneous)
+    if kind == "Box":
+        kind, half = "box", np.array(shape.halfSide, dtype=float)
+    elif kind == "Cylinder":
+        kind, half = "cylinder", np.array([shape.radius, shape.halfLength, 0.0])
+    elif kind.startswith(("BVHModel", "Convex")):
+        shape, offset = _mesh_hull(shape, name)
+        placement = placement @ offset
+        points = np.array(shape.points(), dtype=float).reshape(-1, 3)
+        kind, half = "mesh", np.abs(points).max(axis=0)
+    else:
+        raise CollisionModelError(name, f"shape {kind} is not supported (box, cylinder, mesh)")
+    centres, radius = _cover(kind, half)
+    bounding = float(np.linalg.norm(half)) if kind != "cylinder" else math.hypot(half[0], half[1])
     joint = int(geometry_object.parentJoint)
     reach = np.zeros(model.nq)
     # Distance of any point of the primitive from joint j's origin (on its axis), bounded by the
@@ -101,12 +143,14 @@ def link_primitive(
     for array in (placement, half, centres, reach):
         array.setflags(write=False)
     link = model.frames[geometry_object.parentFrame].name
-    return LinkPrimitive(name, link, joint, placement, kind.lower(), half, centres, radius, reach)
+    return LinkPrimitive(name, link, joint, placement, kind, half, centres, radius, reach, shape)
 
 
 def fcl_shape(primitive: LinkPrimitive) -> Any:
     import fcl
 
+    if primitive.kind == "mesh":
+        raise CollisionModelError(primitive.geometry, "the fcl engine takes boxes and cylinders")
     if primitive.kind == "box":
         return fcl.Box(*(2.0 * primitive.half_extents).tolist())
     radius, half_length, _ = primitive.half_extents.tolist()

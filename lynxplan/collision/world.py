@@ -1,8 +1,8 @@
 """The collision world: the arm's URDF collision primitives and the obstacles, built once.
 
-Every link primitive (box or cylinder of the URDF's ``<collision>`` elements, read through
-Pinocchio's GeometryModel) becomes one collision object when the world is built; a query only
-moves those objects (``setRotation``/``setTranslation``). The obstacles' objects never move.
+Every link primitive (box, cylinder or mesh hull of the URDF's ``<collision>`` elements, read
+through Pinocchio's GeometryModel) becomes one collision object when the world is built; a query
+only moves those objects (``setRotation``/``setTranslation``). The obstacles' objects never move.
 
 Two distance engines, both built once:
 
@@ -29,6 +29,7 @@ answer cannot matter (branch and bound), never to report a clearance.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 import numpy as np
@@ -105,7 +106,7 @@ class CollisionWorld:
             array.setflags(write=False)
         if engine == "fcl":
             self._build_fcl()
-        shapes = [g.geometry for g in arm.collision_model.geometryObjects]
+        shapes = [p.shape for p in self.links]
         self._coal_link_poses = [coal.Transform3s() for _ in self.links]
         self._coal_obstacle_poses = [
             coal.Transform3s(np.asarray(o.rotation), o.centre) for o in self.obstacles
@@ -216,18 +217,27 @@ class CollisionWorld:
             return self._coal_distance(poses, pair)
         return self._fcl_distance(poses, pair)
 
-    def _coal_distance(self, poses: np.ndarray, pair: int) -> float:
+    def _posed_pair(
+        self, links: Sequence[Any], obstacles: Sequence[Any], poses: np.ndarray, pair: int
+    ) -> tuple[Any, Any]:
+        """The engine objects of one pair, the links' moved to ``poses`` (G, 4, 4) [m]: ``links``
+        and ``obstacles`` are one engine's placements (coal ``Transform3f``, fcl objects)."""
         a = int(self.pair_link[pair])
-        first = self._coal_link_poses[a]
+        first = links[a]
         first.setRotation(poses[a, :3, :3])
         first.setTranslation(poses[a, :3, 3])
-        if self.pair_is_self[pair]:
-            b = int(self.pair_other[pair])
-            second = self._coal_link_poses[b]
-            second.setRotation(poses[b, :3, :3])
-            second.setTranslation(poses[b, :3, 3])
-        else:
-            second = self._coal_obstacle_poses[int(self.pair_other[pair])]
+        if not self.pair_is_self[pair]:
+            return first, obstacles[int(self.pair_other[pair])]
+        b = int(self.pair_other[pair])
+        second = links[b]
+        second.setRotation(poses[b, :3, :3])
+        second.setTranslation(poses[b, :3, 3])
+        return first, second
+
+    def _coal_distance(self, poses: np.ndarray, pair: int) -> float:
+        first, second = self._posed_pair(
+            self._coal_link_poses, self._coal_obstacle_poses, poses, pair
+        )
         # A DistanceResult keeps the minimum over calls: a fresh one per query.
         result = self._coal_result_type()
         return float(self._coal_pairs[pair](first, second, self._coal_request, result))
@@ -252,17 +262,7 @@ class CollisionWorld:
     def _fcl_distance(self, poses: np.ndarray, pair: int) -> float:
         import fcl
 
-        a = int(self.pair_link[pair])
-        first = self._link_objects[a]
-        first.setRotation(poses[a, :3, :3])
-        first.setTranslation(poses[a, :3, 3])
-        if self.pair_is_self[pair]:
-            b = int(self.pair_other[pair])
-            second = self._link_objects[b]
-            second.setRotation(poses[b, :3, :3])
-            second.setTranslation(poses[b, :3, 3])
-        else:
-            second = self._obstacle_objects[int(self.pair_other[pair])]
+        first, second = self._posed_pair(self._link_objects, self._obstacle_objects, poses, pair)
         return float(fcl.distance(first, second, self._request))
 
     def distances(self, q: Any) -> np.ndarray:

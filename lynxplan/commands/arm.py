@@ -13,7 +13,13 @@ import numpy as np
 
 from lynxplan import guards
 from lynxplan.commands import robots as robots_cmd
-from lynxplan.commands._output import parse_finite, parse_json_numbers, print_json
+from lynxplan.commands._output import (
+    ik_branch_rows,
+    parse_finite,
+    parse_json_numbers,
+    print_ik_branches,
+    print_json,
+)
 from lynxplan.exceptions import InputError, ShapeError
 from lynxplan.units import LENGTH_UNITS, angle_factor, length_factor
 
@@ -129,19 +135,12 @@ def handle_ik(args: argparse.Namespace) -> int:
         strict=args.strict,
         orientation_tolerance=guards.tolerance("--tolerance", args.tolerance, "rad"),
     )
-    listed = [i for i, s in enumerate(result.solutions) if args.all or s.within_limits]
-    length = length_factor(units["length"])
-    solutions = [
-        {
-            "q": (result.solutions[i].q / scale).tolist(),
-            "branch": result.solutions[i].branch,
-            "within_limits": result.solutions[i].within_limits,
-            "orientation_error": result.solutions[i].orientation_error,
-            "position_error": result.solutions[i].position_error / length,
-        }
-        for i in listed
-    ]
-    selected = listed.index(result.selected) if result.selected in listed else None
+    solutions, selected = ik_branch_rows(
+        result,
+        show_all=args.all,
+        angle_scale=scale,
+        length_scale=length_factor(units["length"]),
+    )
     if args.json:
         print_json(
             {
@@ -152,12 +151,5 @@ def handle_ik(args: argparse.Namespace) -> int:
             }
         )
         return 0
-    print(f"orientation residual: {result.orientation_residual:.3g} rad")
-    if not solutions:
-        print("no solution within the joint limits (use --all to list every branch)")
-    for k, solution in enumerate(solutions):
-        mark = "*" if k == selected else " "
-        angles = "  ".join(f"{v:10.4f}" for v in solution["q"])
-        flag = "" if solution["within_limits"] else "  (outside limits)"
-        print(f"{mark} {solution['branch']:<17} {angles} {units['angle']}{flag}")
+    print_ik_branches(result, solutions, selected, units["angle"], branch_width=17)
     return 0

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from lynxplan.commands._output import parse_finite, print_json
+from lynxplan.commands._output import ik_branch_rows, parse_finite, print_ik_branches, print_json
 from lynxplan.exceptions import InputError
 from lynxplan.units import angle_factor, length_factor
 
@@ -44,8 +44,11 @@ def add_robot_options(parser: argparse.ArgumentParser) -> None:
 
 
 def wants_robot(args: argparse.Namespace) -> bool:
-    """Whether a command was given a robot (then it runs through lynxplan.robots)."""
-    return bool(getattr(args, "robot", None) or getattr(args, "urdf", None))
+    """Whether a command was given a robot or a tool frame (then it runs through
+    lynxplan.robots: a ``--tool`` of the AL5 is checked, never ignored)."""
+    return bool(
+        getattr(args, "robot", None) or getattr(args, "urdf", None) or getattr(args, "tool", None)
+    )
 
 
 def _load(args: argparse.Namespace) -> Any:
@@ -199,19 +202,11 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
             "ik: the following arguments are required: --pose"
             " (or --position with --approach or --pitch)"
         )
-    listed = [i for i, s in enumerate(result.solutions) if args.all or s.within_limits]
-    solutions = [
-        {
-            "q": (result.solutions[i].q / scale).tolist(),
-            "branch": result.solutions[i].branch,
-            "within_limits": result.solutions[i].within_limits,
-            "position_error": result.solutions[i].position_error / length,
-            "orientation_error": result.solutions[i].orientation_error,
-            "verified": True,
-        }
-        for i in listed
-    ]
-    selected = listed.index(result.selected) if result.selected in listed else None
+    solutions, selected = ik_branch_rows(
+        result, show_all=args.all, angle_scale=scale, length_scale=length
+    )
+    for row in solutions:
+        row["verified"] = True
     if args.json:
         print_json(
             {
@@ -237,12 +232,5 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
         print(
             f"unreachable: nearest solution misses by {result.distance / length:.6g} {unit_length}"
         )
-    print(f"orientation residual: {result.orientation_residual:.3g} rad")
-    if not solutions:
-        print("no solution within the joint limits (use --all to list every branch)")
-    for k, s in enumerate(solutions):
-        mark = "*" if k == selected else " "
-        angles = "  ".join(f"{v:10.4f}" for v in s["q"])
-        flag = "" if s["within_limits"] else "  (outside limits)"
-        print(f"{mark} {s['branch']:<24} {angles} {unit_angle}{flag}")
+    print_ik_branches(result, solutions, selected, unit_angle, branch_width=24)
     return 0

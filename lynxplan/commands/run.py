@@ -18,7 +18,9 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("scenario", help="scenario YAML file")
     parser.add_argument("--out", default="out", help="output folder (default: ./out)")
-    parser.add_argument("--quick", action="store_true", help="skip plots and HTML")
+    parser.add_argument(
+        "--quick", action="store_true", help="skip plots, HTML and the ruckig/toppra comparisons"
+    )
     parser.add_argument(
         "--force",
         action="store_true",

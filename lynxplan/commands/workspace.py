@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from lynxplan import guards
+from lynxplan.commands import robots as robots_cmd
 from lynxplan.commands._output import parse_finite
 from lynxplan.units import LENGTH_UNITS
 
@@ -31,6 +32,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--voxel", default="10", help="voxel edge in mm (default 10)")
     parser.add_argument("--seed", default="0", help="random seed, 0 <= seed < 2**63 (default 0)")
     parser.add_argument("--json", action="store_true", help="print workspace.json to stdout")
+    robots_cmd.add_robot_options(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -38,7 +40,7 @@ def handle(args: argparse.Namespace) -> int:
     """Run the workspace analysis with the command-line settings."""
     from lynxplan.exceptions import InputError
     from lynxplan.scenarios import workspace as workspace_scenario
-    from lynxplan.scenarios.base import Units
+    from lynxplan.scenarios.base import RobotRef, Units
     from lynxplan.scenarios.outputs import staged_outputs
 
     if args.quick and args.samples is not None:
@@ -60,6 +62,11 @@ def handle(args: argparse.Namespace) -> int:
         voxel_size=voxel * mm_to_unit,
         seed=seed,
         units=Units(length=args.units, angle="deg"),
+        robot=RobotRef(
+            name=args.robot or ("al5" if args.tool and not args.urdf else None),
+            urdf=args.urdf,
+            tool=args.tool,
+        ),
     )
     out = Path(args.out)
     with staged_outputs(out, force=getattr(args, "force", False)) as staging:

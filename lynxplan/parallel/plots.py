@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan._plotting import pyplot, save_figure
 from lynxplan.parallel.geometry import ParallelGeometry
 from lynxplan.parallel.ik import WORKING_MODES, elbows, mode_index, platform_joints, solve_ik
 from lynxplan.parallel.singular import type1_circles, type2_grid
@@ -19,15 +20,6 @@ from lynxplan.parallel.workspace import Workspace
 
 _DEFAULT_GEOMETRY = ParallelGeometry()
 _LEG_COLOURS = ("tab:red", "tab:green", "tab:blue")
-
-
-def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def _draw_base(ax: Any, geometry: ParallelGeometry) -> None:
@@ -61,7 +53,7 @@ def plot_postures(
     pose: np.ndarray, path: str | Path, geometry: ParallelGeometry = _DEFAULT_GEOMETRY
 ) -> Path:
     """The 8 working modes of ``pose`` (3,) in [m, m, rad] in a 2x4 grid (report figure 19)."""
-    plt = _pyplot()
+    plt = pyplot()
     theta = solve_ik(pose, geometry)
     fig, axes = plt.subplots(2, 4, figsize=(16, 8.5))
     for m, ax in enumerate(axes.ravel()):
@@ -70,11 +62,7 @@ def plot_postures(
         ax.set_title(f"mode {m + 1} ({WORKING_MODES[m]}): θ = ({angles})°", fontsize=8)
     x, y, alpha = pose[0] * 1e3, pose[1] * 1e3, math.degrees(pose[2])
     fig.suptitle(f"3-RRR working modes for pose ({x:.1f} mm, {y:.1f} mm, {alpha:.1f}°)")
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)
 
 
 def plot_workspace(
@@ -86,7 +74,7 @@ def plot_workspace(
 ) -> Path:
     """The workspace points with the base triangle, Type I circles and the Type II locus of
     working mode ``loci_mode`` (None: no loci)."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 7.5))
     x_mm, y_mm = workspace.x * 1e3, workspace.y * 1e3
     extent = (
@@ -136,8 +124,4 @@ def plot_workspace(
         fontsize=10,
     )
     ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    path = Path(path)
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path)

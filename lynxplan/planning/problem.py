@@ -19,7 +19,9 @@ from lynxplan.exceptions import (
     GoalUnreachableError,
     KinematicsError,
     NonFiniteInputError,
+    OrientationNotReachableError,
     ShapeError,
+    UnreachablePoseError,
 )
 from lynxplan.planning.space import JointSpace
 
@@ -124,6 +126,46 @@ class GoalSet:
     labels: tuple[str, ...] = field(default=())
 
 
+#: A goal branch must reach the target position to this, in [m] ...
+GOAL_POSITION_TOLERANCE = 1e-9
+#: ... and a URDF robot's branch the orientation (approach axis) to this, in [rad]: its IK
+#: polishes off-family models (the SO-101's axes are 3.7e-6 rad off parallel) to ~6e-6 rad.
+ROBOT_GOAL_ORIENTATION_TOLERANCE = 1e-5
+
+
+def _exact_solutions(
+    robot: Any, pose: np.ndarray, approach_only: bool, reference: np.ndarray | None
+) -> tuple[Any, ...]:
+    """The IK branches that reach ``pose`` (4, 4): the position exactly, and the orientation (or,
+    ``approach_only``, the approach axis) within the AL5's
+    :data:`~lynxplan.constants.STRICT_ORIENTATION_TOLERANCE` or a URDF robot's
+    :data:`ROBOT_GOAL_ORIENTATION_TOLERANCE`.
+
+    Raises:
+        KinematicsError: the pose is out of reach (the AL5's strict IK; a URDF robot's nearest
+            solution misses it).
+    """
+    from lynxplan.arm.model import Arm
+
+    if isinstance(robot, Arm):
+        result = robot.ik(pose, approach_only=approach_only, strict=True, q_reference=reference)
+        return tuple(result.solutions)
+    result = robot.ik(pose, approach_only=approach_only, q_reference=reference)
+    exact = tuple(
+        s
+        for s in result.solutions
+        if s.position_error <= GOAL_POSITION_TOLERANCE
+        and s.orientation_error <= ROBOT_GOAL_ORIENTATION_TOLERANCE
+    )
+    if not exact and result.distance > GOAL_POSITION_TOLERANCE:
+        raise UnreachablePoseError(result.distance, "nearest solution of the robot's IK")
+    if not exact:
+        raise OrientationNotReachableError(
+            result.orientation_residual, ROBOT_GOAL_ORIENTATION_TOLERANCE
+        )
+    return exact
+
+
 def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> GoalSet:
     """Every configuration reaching ``goal`` within the joint limits (IK: every branch).
 
@@ -138,9 +180,13 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
         goal = PoseGoal(array) if array.shape == (4, 4) else JointGoal(array)
     if isinstance(goal, JointGoal):
         return GoalSet(space.check(goal.q, "goal")[None, :], ("joint goal",))
+    from lynxplan.arm.model import Arm
+
     approach_only = isinstance(goal, ApproachGoal)
-    if isinstance(goal, PoseGoal):
-        poses, references = goal.pose[None], [None]
+    if isinstance(goal, PoseGoal) or not isinstance(robot, Arm):
+        # A URDF robot's IK leaves the roll free for an approach goal: every root, exactly.
+        poses = goal.pose[None] if isinstance(goal, PoseGoal) else goal.poses()[:1]
+        references = [None]
     else:
         # The roll about the approach axis is the last joint's (yaw-pitch^3-roll family): one
         # IK per sampled last-joint angle.
@@ -152,11 +198,11 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
     reasons: list[str] = []
     for pose, reference in zip(poses, references, strict=True):
         try:
-            result = robot.ik(pose, approach_only=approach_only, strict=True, q_reference=reference)
+            solutions = _exact_solutions(robot, pose, approach_only, reference)
         except KinematicsError as exc:
             reasons.append(str(exc))
             continue
-        for solution in result.solutions:
+        for solution in solutions:
             q = np.asarray(solution.q, dtype=float)
             if not solution.within_limits or not np.isfinite(q).all():
                 continue

@@ -152,7 +152,7 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
 
 
 def _box_half_extents(kind: str, half: np.ndarray) -> np.ndarray:
-    if kind == "box":
+    if kind in ("box", "mesh"):  # a mesh primitive is its hull, inside this box
         return np.array(half, dtype=float)
     radius, half_length = float(half[0]), float(half[1])
     return np.array([radius, radius, half_length])

@@ -5,7 +5,8 @@ A scenario kind is one module of :mod:`lynxplan.scenarios` registered in
 
 - ``Input``: a :class:`ScenarioModel` subclass (validation only, never computation) whose
   ``metrics`` class variable declares the metrics ``run`` measures and their quantities;
-- ``run(scenario) -> KindOutput``: the computation, pure (writes no file);
+- ``run(scenario, *, quick) -> KindOutput``: the computation, pure (writes no file); ``quick``
+  skips work no expectation needs (the comparisons with peer time laws);
 - ``write_outputs(scenario, output, out_dir, *, quick) -> list[str]``: the artifacts (CSV, PNG,
   HTML) written into ``out_dir``, returned as paths relative to it.
 
@@ -18,12 +19,18 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, ClassVar, Literal, Protocol
+from typing import Annotated, Any, ClassVar, Literal, Protocol
 
 from pydantic import BaseModel, ConfigDict, Field, model_validator
 
 #: Version of the ``report.json`` layout (:class:`Result`); bumped on incompatible changes.
 SCHEMA_VERSION = 1
+
+#: Field types shared by the kinds' input models.
+Finite = Annotated[float, Field(allow_inf_nan=False)]
+Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
+Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
+Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 
 #: Physical quantity of a metric: selects the units an expectation may use.
 Quantity = Literal[
@@ -95,6 +102,25 @@ class RobotRef(StrictModel):
             raise ValueError("give name or urdf, not both")
         if self.tool is not None and self.urdf is None and self.name is None:
             raise ValueError("tool needs name or urdf")
+        return self
+
+
+class TargetEntry(StrictModel):
+    """A target of the arm: joint angles, a 4x4 tool pose, or a tool point with an approach
+    direction (exactly one form; see :func:`check_target_form`)."""
+
+    q: Annotated[list[Finite], Field(min_length=1, max_length=12)] | None = Field(
+        None, description="Joint angles, in the file's angle unit."
+    )
+    pose: Annotated[list[list[Finite]], Field(min_length=3, max_length=4)] | None = Field(
+        None, description="Tool pose: 3 or 4 rows of 4 (translation in the file's length unit)."
+    )
+    position: Vector3 | None = Field(None, description="Tool point (with approach).")
+    approach: Vector3 | None = Field(None, description="Tool approach axis (z) direction.")
+
+    @model_validator(mode="after")
+    def _one_form(self) -> TargetEntry:
+        check_target_form(self)
         return self
 
 
@@ -244,7 +270,7 @@ class ScenarioKind(Protocol):
     NAME: str
     Input: type[ScenarioModel]
 
-    def run(self, scenario: Any) -> KindOutput: ...
+    def run(self, scenario: Any, *, quick: bool = False) -> KindOutput: ...
 
     def write_outputs(
         self, scenario: Any, output: KindOutput, out_dir: Path, *, quick: bool

@@ -19,6 +19,7 @@ import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -159,6 +160,13 @@ def write_trajectory_csv(
         columns.append(tool_xyz)
     table = np.hstack(columns)
     np.savetxt(path, table, delimiter=",", header=",".join(names), comments="", fmt="%.15g")
+
+
+def write_samples_csv(path: Path, samples: Any) -> None:
+    """:func:`write_trajectory_csv` of plan samples (``lynxplan.trajectory.PlanSamples``: ``t``,
+    ``q``, ``qd``, ``qdd`` and the tool poses ``tool`` (N, 4, 4), whose points are written)."""
+    tool = samples.tool[:, :3, 3]
+    write_trajectory_csv(path, samples.t, samples.q, samples.qd, samples.qdd, tool)
 
 
 def artifact_names(out_dir: Path, paths: Sequence[Path | str]) -> list[str]:

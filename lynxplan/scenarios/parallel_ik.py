@@ -51,7 +51,18 @@ class GeometrySpec(StrictModel):
         return {k: None if v is None else v * scale for k, v in self.model_dump().items()}
 
 
-class Input(ScenarioModel):
+class ParallelScenario(ScenarioModel):
+    """Fields of every 3-RRR kind: the units (default mm and deg) and the robot's dimensions."""
+
+    units: Units = Units(length="mm", angle="deg")
+    geometry: GeometrySpec = Field(default_factory=GeometrySpec)
+
+    def si_inputs(self) -> dict[str, Any]:
+        """Kind, name and the dimensions in [m]; each kind adds its own inputs."""
+        return {"kind": self.kind, "name": self.name, "geometry": self.geometry.si(self.units)}
+
+
+class Input(ParallelScenario):
     """A ``parallel_ik`` scenario."""
 
     metrics: ClassVar[dict[str, Quantity]] = {
@@ -66,22 +77,18 @@ class Input(ScenarioModel):
     }
 
     kind: Literal["parallel_ik"]
-    units: Units = Units(length="mm", angle="deg")
-    geometry: GeometrySpec = Field(default_factory=GeometrySpec)
     pose: tuple[float, float, float] = Field(description="xc, yc (length unit), alpha (angle).")
 
     def si_inputs(self) -> dict[str, Any]:
         """Inputs in [m] and [rad]."""
         length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
         return {
-            "kind": self.kind,
-            "name": self.name,
-            "geometry": self.geometry.si(self.units),
+            **super().si_inputs(),
             "pose": [self.pose[0] * length, self.pose[1] * length, self.pose[2] * angle],
         }
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Solve the IK, verify each mode by FK and by the Pinocchio closure."""
     from lynxplan.parallel.fk import pose_distance, solve_fk
     from lynxplan.parallel.ik import WORKING_MODES, solve_ik

@@ -20,8 +20,8 @@ from typing import Any, ClassVar, Literal
 
 from pydantic import Field, model_validator
 
-from lynxplan.scenarios.base import KindOutput, Quantity, ScenarioModel, StrictModel, Units
-from lynxplan.scenarios.parallel_ik import GeometrySpec
+from lynxplan.scenarios.base import KindOutput, Quantity, StrictModel
+from lynxplan.scenarios.parallel_ik import ParallelScenario
 from lynxplan.units import angle_factor, length_factor
 
 NAME = "parallel_workspace"
@@ -37,14 +37,12 @@ class Region(StrictModel):
     y: tuple[float, float] = (0.0, 320.0)
 
 
-class Input(ScenarioModel):
+class Input(ParallelScenario):
     """A ``parallel_workspace`` scenario."""
 
     metrics: ClassVar[dict[str, Quantity]] = {"area": "area"}
 
     kind: Literal["parallel_workspace"]
-    units: Units = Units(length="mm", angle="deg")
-    geometry: GeometrySpec = Field(default_factory=GeometrySpec)
     alphas: list[float] = Field(min_length=1, max_length=360, description="Orientations.")
     step: float = Field(gt=0, allow_inf_nan=False, description="Grid step (length unit).")
     region: Region = Field(default_factory=Region)
@@ -69,9 +67,7 @@ class Input(ScenarioModel):
         """Inputs in [m] and [rad]."""
         length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
         return {
-            "kind": self.kind,
-            "name": self.name,
-            "geometry": self.geometry.si(self.units),
+            **super().si_inputs(),
             "alphas": [a * angle for a in self.alphas],
             "step": self.step * length,
             "region": {
@@ -83,7 +79,7 @@ class Input(ScenarioModel):
         }
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Compute each orientation's workspace."""
     from lynxplan.parallel.workspace import constant_orientation_workspace
 

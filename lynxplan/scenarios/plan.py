@@ -50,22 +50,23 @@ from pathlib import Path
 from typing import Annotated, Any, ClassVar, Literal
 
 import numpy as np
-from pydantic import Field, model_validator
-from typing_extensions import Self
+from pydantic import Field
 
 from lynxplan.scenarios.base import (
     SI_UNITS,
+    Finite,
     KindOutput,
+    Positive,
     Quantity,
     RobotRef,
     ScenarioModel,
     StrictModel,
+    TargetEntry,
     Units,
-    check_target_form,
     scale_translation,
     scaled,
 )
-from lynxplan.scenarios.task import Finite, ObstacleEntry, OutputsEntry, Positive, Vector3
+from lynxplan.scenarios.task import ObstacleEntry, OutputsEntry
 from lynxplan.units import angle_factor, length_factor
 
 NAME = "plan"
@@ -73,22 +74,8 @@ NAME = "plan"
 PerJoint = Positive | Annotated[list[Positive], Field(min_length=1, max_length=12)]
 
 
-class GoalEntry(StrictModel):
-    """A goal: joint angles, a tool pose (every IK branch), or a position + approach."""
-
-    q: Annotated[list[Finite], Field(min_length=1, max_length=12)] | None = Field(
-        None, description="Joint angles, in the file's angle unit."
-    )
-    pose: Annotated[list[list[Finite]], Field(min_length=3, max_length=4)] | None = Field(
-        None, description="Tool pose: 3 or 4 rows of 4 (translation in the file's length unit)."
-    )
-    position: Vector3 | None = Field(None, description="Tool point (with approach).")
-    approach: Vector3 | None = Field(None, description="Tool approach axis (z) direction.")
-
-    @model_validator(mode="after")
-    def _one_form(self) -> Self:
-        check_target_form(self)
-        return self
+class GoalEntry(TargetEntry):
+    """A start or goal: joint angles, a tool pose (every IK branch), or a position + approach."""
 
 
 class PlannerEntry(StrictModel):
@@ -238,11 +225,11 @@ class PlanInputs:
 
 
 def plan_inputs(scenario: Input) -> PlanInputs:
-    """The planner inputs of a scenario (loads the robot)."""
-    from lynxplan.scenarios.robot import load_arm_robot
+    """The planner inputs of a scenario (loads the robot: the AL5 or any URDF robot)."""
+    from lynxplan.scenarios.robot import load_robot_entry
 
     return PlanInputs(
-        load_arm_robot(scenario.robot),
+        load_robot_entry(scenario.robot),
         _obstacles(scenario),
         np.array(scenario.start) * angle_factor(scenario.units.angle),
         _goal(scenario),
@@ -253,7 +240,7 @@ def plan_inputs(scenario: Input) -> PlanInputs:
     )
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Plan, verify, time-parameterise; measure limits and per-sample clearance (no files)."""
     import time
 

@@ -136,7 +136,7 @@ def execute(
 
     start = time.perf_counter()
     try:
-        output = loaded.kind.run(loaded.scenario)
+        output = loaded.kind.run(loaded.scenario, quick=quick)
     except ScenarioError:
         raise
     except ScenarioValueError as exc:
@@ -183,7 +183,7 @@ def run_scenario(
     Args:
         source: Scenario YAML file, or the scenario as a mapping.
         out_dir: Output folder (replaced as a whole by a complete run), or None to write nothing.
-        quick: Skip slow outputs (plots, HTML).
+        quick: Skip plots, HTML and the comparisons with peer time laws.
         force: Replace ``out_dir`` even if it holds files lynxplan did not write.
 
     Returns:

@@ -197,7 +197,7 @@ def line_distance_to_base_axis(start: np.ndarray, end: np.ndarray) -> float:
     return float(np.linalg.norm(a + s * direction))
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Run the four strategies on the scenario's path (no files)."""
     problem = build_problem(scenario)
     arm = load_arm()

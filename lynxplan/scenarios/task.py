@@ -5,7 +5,7 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
     kind: task
     name: pick and place
     units: {length: in, angle: deg}          # lengths in|mm|m, angles deg|rad
-    robot: {}                                # the shipped AL5; or {urdf: path/to.urdf}
+    robot: {}                                # the shipped AL5; {name: so101}; {urdf: .., tool: ..}
     sample_rate: 1000                        # [Hz]
     timing: {tt: 2.0, ta: 0.5}               # default of every segment [s]; or: auto
     limits: {acceleration: 450, jerk: 3400}  # per joint (scalar or 5 values), angle unit / s^n
@@ -32,9 +32,12 @@ Example (``scenarios/ok_task.yaml`` is the full SPEC Part 3 task)::
       min_clearance: ">= 0.2 in"      # comparator, number, unit (default: the file's unit)
       max_duration: "<= 30 s"
 
-Robots: task scenarios plan with the AL5's analytic IK, so the robot must have the AL5's joint
-structure (the shipped URDF or a variant with other link lengths or collision shapes). A robot of
-another structure is rejected at run time with a message saying so.
+Robots: the shipped AL5 (default; also any URDF of its joint structure, solved with its closed
+form), ``{name: so100}`` / ``{name: so101}`` or ``{urdf: path, tool: frame}`` of any 5-joint
+yaw-pitch-pitch-pitch-roll arm (closed-form / root-search IK of :func:`lynxplan.load_robot`, mesh
+collision geometry as convex hulls). A waypoint's ``ik: report`` is the AL5's branch rule; other
+robots take the branch nearest ``q_reference`` (default: zeros). ``scenarios/so101_writing.yaml``
+is the SO-101 example.
 
 Relative URDF paths are resolved from the current working directory.
 
@@ -54,13 +57,17 @@ from typing_extensions import Self
 
 from lynxplan.scenarios.base import (
     SI_UNITS,
+    Finite,
     KindOutput,
+    Matrix3,
+    Positive,
     Quantity,
     RobotRef,
     ScenarioModel,
     StrictModel,
+    TargetEntry,
     Units,
-    check_target_form,
+    Vector3,
     located_error,
     scale_translation,
     scaled,
@@ -70,10 +77,6 @@ from lynxplan.units import angle_factor, length_factor
 
 NAME = "task"
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
-Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
-Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
 PerJoint = Positive | Annotated[list[Positive], Field(min_length=5, max_length=5)]
 
 
@@ -141,17 +144,12 @@ class CylinderEntry(_Oriented):
 ObstacleEntry = Annotated[BoxEntry | SphereEntry | CylinderEntry, Field(discriminator="type")]
 
 
-class WaypointEntry(StrictModel):
+class WaypointEntry(TargetEntry):
     """A waypoint: joint angles, a 4x4 pose, or a position with an approach direction."""
 
     q: Annotated[list[Finite], Field(min_length=5, max_length=5)] | None = Field(
         None, description="Joint angles q1..q5, in the file's angle unit."
     )
-    pose: Annotated[list[list[Finite]], Field(min_length=3, max_length=4)] | None = Field(
-        None, description="Tool pose: 3 or 4 rows of 4 (translation in the file's length unit)."
-    )
-    position: Vector3 | None = Field(None, description="Tool point (with approach).")
-    approach: Vector3 | None = Field(None, description="Tool approach axis (z) direction.")
     ik: Literal["report", "nearest"] = Field(
         "report",
         description="IK branch: the report's rule (first within limits with q2 >= 0, q3 <= 0) "
@@ -160,11 +158,6 @@ class WaypointEntry(StrictModel):
     q_reference: Annotated[list[Finite], Field(min_length=5, max_length=5)] | None = Field(
         None, description="For ik: nearest and for q5 of a position + approach target."
     )
-
-    @model_validator(mode="after")
-    def _one_form(self) -> Self:
-        check_target_form(self)
-        return self
 
 
 class TimingEntry(StrictModel):
@@ -303,7 +296,7 @@ class Input(ScenarioModel):
 Scenario = Input
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Resolve the scenario (IK of the waypoints, the plan), sample, check, compare (no files)."""
     from lynxplan.progress import progress_bar
     from lynxplan.task.report import summary, task_details, task_metrics, task_notes
@@ -312,7 +305,7 @@ def run(scenario: Input) -> KindOutput:
 
     with progress_bar(f"task {scenario.name}".strip()) as progress:
         setup = resolve(scenario)
-        result = execute(scenario, setup, progress)
+        result = execute(scenario, setup, progress, compare=scenario.compare and not quick)
         progress(5, 5)
     return KindOutput(
         task_metrics(result),
@@ -326,19 +319,12 @@ def run(scenario: Input) -> KindOutput:
 
 def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
     """``trajectory.csv`` and, unless quick, the plots and the meshcat HTML."""
-    from lynxplan.scenarios.outputs import write_trajectory_csv
+    from lynxplan.scenarios.outputs import write_samples_csv
     from lynxplan.task.run import html_name
 
     result = output.payload
     samples = result.samples
-    write_trajectory_csv(
-        out_dir / "trajectory.csv",
-        samples.t,
-        samples.q,
-        samples.qd,
-        samples.qdd,
-        samples.tool[:, :3, 3],
-    )
+    write_samples_csv(out_dir / "trajectory.csv", samples)
     written = ["trajectory.csv"]
     if quick:
         return written

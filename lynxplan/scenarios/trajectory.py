@@ -4,6 +4,7 @@ Example (``scenarios/free_motion.yaml``)::
 
     kind: trajectory
     units: {length: in, angle: rad}
+    robot: {}                             # the AL5 (default); {name: so101}; {urdf: .., tool: ..}
     start: [0, 0, 0, 0, 0]               # joint angles, in the file's angle unit
     limits: {acceleration: 8.0, jerk: 60.0}   # per joint (scalar or 5 values), angle unit/s^n
     sample_rate: 1000                     # [Hz]
@@ -15,11 +16,14 @@ Example (``scenarios/free_motion.yaml``)::
     plot: {segment: 0, joint: 2}          # the report's q2(t) figure: segment index, joint 1..5
     expect: {max_line_deviation: "<= 1e-9 m", joint_limits_respected: true}
 
-Velocity limits come from the URDF. Metrics: ``line_deviation`` [m] (largest tool-point distance
-from the lines), ``joint_limits_respected``, ``branch_switches`` (IK branch changes along lines),
-``duration`` [s]. Artifacts: ``trajectory.csv`` (t, q, qd, qdd and the tool point x, y, z, SI)
-and, unless quick, ``joint_profiles.png``, ``tool_xyz.png`` and ``durations.png``; the per-segment
-figures and the comparison table are in ``report.json`` details.
+Robots: as in ``task`` scenarios, the AL5 or any 5-joint yaw-pitch-pitch-pitch-roll arm from
+URDF. Position and velocity limits come from the URDF.
+
+Metrics: ``line_deviation`` [m] (largest tool-point distance from the lines),
+``joint_limits_respected``, ``branch_switches`` (IK branch changes along lines), ``duration``
+[s]. Artifacts: ``trajectory.csv`` (t, q, qd, qdd and the tool point x, y, z, SI) and, unless
+quick, ``joint_profiles.png``, ``tool_xyz.png`` and ``durations.png``; the per-segment figures
+and the comparison table are in ``report.json`` details.
 """
 
 from __future__ import annotations
@@ -32,12 +36,14 @@ from pydantic import Field, ValidationError, model_validator
 from pydantic_core import InitErrorDetails, PydanticCustomError
 
 from lynxplan.arm.geometry import JointLimits
-from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.scenarios.base import (
     SI_UNITS,
+    Finite,
     KindOutput,
+    Positive,
     Quantity,
+    RobotRef,
     ScenarioModel,
     StrictModel,
     Units,
@@ -58,8 +64,6 @@ from lynxplan.trajectory.plan import (
 from lynxplan.trajectory.retime import TOPPRA_LIMIT_SAFETY
 from lynxplan.units import angle_factor, length_factor
 
-Finite = Annotated[float, Field(allow_inf_nan=False)]
-Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 #: A per-joint limit: one value for every joint, or one value per joint (5).
 PerJoint = Positive | Annotated[list[Positive], Field(min_length=5, max_length=5)]
 
@@ -109,16 +113,21 @@ class LimitsEntry(StrictModel):
     )
     jerk: PerJoint | None = Field(default=None, description=f"Default {DEFAULT_MAX_JERK} rad/s^3.")
 
-    def build(self, units: Units) -> MotionLimits:
-        """:class:`MotionLimits` in SI (velocity from the URDF defaults)."""
+    def build(self, units: Units, robot: Any = None) -> MotionLimits:
+        """:class:`MotionLimits` in SI; position and velocity limits from the robot's URDF
+        (default: the AL5's)."""
         factor = angle_factor(units.angle)
         acc = DEFAULT_MAX_ACCELERATION if self.acceleration is None else self.acceleration
         jerk = DEFAULT_MAX_JERK if self.jerk is None else self.jerk
         scale = 1.0 if self.acceleration is None else factor
         jerk_scale = 1.0 if self.jerk is None else factor
+        urdf = {} if robot is None else {"position": robot.limits.position}
+        if robot is not None:
+            urdf["velocity"] = robot.limits.velocity
         return MotionLimits(
             acceleration=np.asarray(acc, dtype=float) * scale,
             jerk=np.asarray(jerk, dtype=float) * jerk_scale,
+            **urdf,
         )
 
 
@@ -141,6 +150,7 @@ class Input(ScenarioModel):
 
     kind: Literal["trajectory"]
     units: Units = Units(length="m", angle="rad")
+    robot: RobotRef = Field(default_factory=RobotRef)
     start: list[Finite] = Field(min_length=5, max_length=5)
     segments: list[SegmentEntry] = Field(min_length=1)
     limits: LimitsEntry = Field(default_factory=LimitsEntry)
@@ -172,11 +182,26 @@ class Input(ScenarioModel):
 
     @model_validator(mode="after")
     def _configurations_within_joint_limits(self) -> Input:
-        """Reject a start or ``to_q`` outside the joint limits, naming the key path.
+        """Reject a start or ``to_q`` outside the AL5's joint limits, naming the key path (for
+        another robot, the run checks its URDF limits the same way).
 
         The check needs the file's angle unit, so it runs on the whole scenario; the error
         carries the offending entry's own location (``start[1]``, ``segments[2].to_q[1]``).
         """
+        if self.robot != RobotRef():
+            return self
+        for loc, message, value in self.outside_limits(JointLimits().position):
+            error = PydanticCustomError("joint_limit", message)
+            raise ValidationError.from_exception_data(
+                type(self).__name__, [InitErrorDetails(type=error, loc=loc, input=value)]
+            )
+        return self
+
+    def outside_limits(
+        self, position: np.ndarray
+    ) -> list[tuple[tuple[int | str, ...], str, float]]:
+        """``(key path, message, value)`` of each start or ``to_q`` angle outside ``position``
+        (n, 2) [rad]."""
         factor = angle_factor(self.units.angle)
         entries: list[tuple[tuple[int | str, ...], list[float]]] = [(("start",), self.start)]
         entries += [
@@ -184,7 +209,7 @@ class Input(ScenarioModel):
             for i, entry in enumerate(self.segments)
             if entry.to_q is not None
         ]
-        position = JointLimits().position
+        found = []
         for loc, values in entries:
             q = np.array(values) * factor
             outside = (q < position[:, 0] - LIMIT_SNAP_TOLERANCE) | (
@@ -196,22 +221,29 @@ class Input(ScenarioModel):
                     f"q{j + 1} = {values[j]:g} {self.units.angle} is outside its joint limits "
                     f"[{low:g}, {high:g}] {self.units.angle}"
                 )
-                error = PydanticCustomError("joint_limit", message)
-                raise ValidationError.from_exception_data(
-                    type(self).__name__,
-                    [InitErrorDetails(type=error, loc=(*loc, int(j)), input=values[j])],
-                )
-        return self
+                found.append(((*loc, int(j)), message, values[j]))
+        return found
 
 
 Scenario = Input
 
 
 def build(scenario: Input) -> Plan:
-    """The scenario's plan (SI units)."""
+    """The scenario's plan (SI units) for its robot.
+
+    Raises:
+        ScenarioValueError: the robot cannot be used, or a start / ``to_q`` angle is outside
+            its joint limits (named by key path).
+    """
+    from lynxplan.exceptions import ScenarioValueError
+    from lynxplan.scenarios.robot import load_path_robot
+
+    robot, kinematics = load_path_robot(scenario.robot)
+    for loc, message, value in scenario.outside_limits(robot.limits.position):
+        raise ScenarioValueError(loc, message, value)
     start = np.array(scenario.start) * angle_factor(scenario.units.angle)
     specs = [entry.spec(scenario.units) for entry in scenario.segments]
-    return build_plan(start, specs, scenario.limits.build(scenario.units))
+    return build_plan(start, specs, scenario.limits.build(scenario.units, robot), kinematics)
 
 
 def _report_json(
@@ -283,13 +315,13 @@ def _metrics(plan: Plan, reports: list[SegmentReport]) -> dict[str, Any]:
     }
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     """Build, sample and compare the plan (no files)."""
     plan = build(scenario)
     samples = plan.sample(scenario.sample_rate)
     reports = segment_reports(plan, samples)
     comparison = None
-    if scenario.compare:
+    if scenario.compare and not quick:
         from lynxplan.trajectory.retime import compare_plan
 
         comparison = compare_plan(plan, scenario.sample_rate)
@@ -315,17 +347,10 @@ def run(scenario: Input) -> KindOutput:
 
 def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
     """``trajectory.csv`` and, unless quick, the plots."""
-    from lynxplan.scenarios.outputs import write_trajectory_csv
+    from lynxplan.scenarios.outputs import write_samples_csv
 
     plan, samples, comparison = output.payload
-    write_trajectory_csv(
-        out_dir / "trajectory.csv",
-        samples.t,
-        samples.q,
-        samples.qd,
-        samples.qdd,
-        samples.tool[:, :3, 3],
-    )
+    write_samples_csv(out_dir / "trajectory.csv", samples)
     if quick:
         return ["trajectory.csv"]
     return ["trajectory.csv", *_write_plots(scenario, plan, samples, comparison, out_dir)]
@@ -363,6 +388,8 @@ def _summary(scenario: Input, plan: Plan, reports: list[SegmentReport], comparis
     if comparison is not None:
         totals = ", ".join(f"{k} {v:.3f} s" for k, v in comparison.total_duration.items())
         text += f"; durations: {totals}"
-    start = forward_kinematics(np.array(scenario.start) * angle_factor(scenario.units.angle))
+    start = plan.kinematics.tool_poses(
+        np.array(scenario.start)[None] * angle_factor(scenario.units.angle)
+    )[0]
     text += f"; start tool point {np.round(start[:3, 3], 4).tolist()} m"
     return text

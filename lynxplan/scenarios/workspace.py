@@ -11,6 +11,10 @@ Example (``scenarios/workspace.yaml``)::
 
 Metrics: ``volume`` [m^3] (revolution of the (r, z) region), ``volume_voxels`` [m^3],
 ``reach`` [m] (largest sampled distance from the shoulder), ``z_min``/``z_max`` [m].
+
+``robot: {name: so101}`` (or ``{urdf: .., tool: ..}``, any chain): the sampled tool points of
+:func:`lynxplan.robots.workspace.sample_workspace`; ``volume_voxels``, ``reach`` (from the base
+origin), ``z_min``/``z_max`` (no planar ``volume``: that envelope is the AL5's).
 Artifacts: ``workspace.json`` and, unless quick, ``workspace_*.png`` and ``workspace.html``.
 """
 
@@ -60,13 +64,17 @@ class Input(ScenarioModel):
         return data
 
 
-def run(scenario: Input) -> KindOutput:
-    """Sample the workspace and measure it (no files)."""
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
+    """Sample the workspace and measure it (no files): the AL5's planar envelope, or the
+    sampled points of any other robot."""
+    from lynxplan.arm.model import Arm
     from lynxplan.arm.workspace import estimate_workspace, report_grid, tool_positions
     from lynxplan.progress import progress_bar
-    from lynxplan.scenarios.robot import load_arm_robot
+    from lynxplan.scenarios.robot import load_robot_entry
 
-    arm = load_arm_robot(scenario.robot)
+    arm = load_robot_entry(scenario.robot)
+    if not isinstance(arm, Arm):
+        return _run_sampled(scenario, arm)
     unit = scenario.units.length
     scale = length_factor(unit)
     with progress_bar("sampling workspace") as progress:
@@ -103,13 +111,56 @@ def run(scenario: Input) -> KindOutput:
     return KindOutput(metrics, summary, details, payload=(estimate, grid))
 
 
+def _run_sampled(scenario: Input, robot: Any) -> KindOutput:
+    """Any robot of ``lynxplan.load_robot``: voxel volume, reach and height of sampled points."""
+    from lynxplan.progress import progress_bar
+    from lynxplan.robots.workspace import sample_workspace
+
+    unit = scenario.units.length
+    scale = length_factor(unit)
+    with progress_bar("sampling workspace") as progress:
+        estimate = sample_workspace(
+            robot,
+            samples=scenario.samples,
+            voxel_size=scenario.voxel_size * scale,
+            seed=scenario.seed,
+            progress=progress,
+        )
+    metrics = {
+        "volume_voxels": estimate.volume_voxels,
+        "reach": estimate.max_reach,
+        "z_min": estimate.z_range[0],
+        "z_max": estimate.z_range[1],
+    }
+    summary = (
+        f"workspace of {robot.name}: {estimate.samples:,} samples, voxel volume "
+        f"{estimate.volume_voxels / scale**3:.4g} {unit}^3 ({scenario.voxel_size:g} {unit} "
+        f"voxels), max reach {estimate.max_reach / scale:.4f} {unit} from the base origin, z "
+        f"from {estimate.z_range[0] / scale:.3f} to {estimate.z_range[1] / scale:.3f} {unit}."
+    )
+    details = {
+        "robot": robot.name,
+        "samples": estimate.samples,
+        "voxel_size": estimate.voxel_size,
+        "method": "tool points of uniform random configurations; voxel occupancy volume",
+    }
+    notes = {"volume": "the planar revolution volume is the AL5's; use volume_voxels"}
+    return KindOutput(metrics, summary, details, payload=estimate, notes=notes)
+
+
 def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
     """``workspace.json`` (in the file's unit) and, unless quick, the plots and the HTML view."""
     from lynxplan.arm.workspace_report import plot_workspace, workspace_summary, write_html
     from lynxplan.scenarios.report import write_json
 
-    estimate, grid = output.payload
     unit = scenario.units.length
+    if not isinstance(output.payload, tuple):  # a URDF robot: the sampled points
+        write_json(out_dir / "workspace.json", {**output.details, "units": {"length": "m"}})
+        if quick:
+            return ["workspace.json"]
+        write_html(output.payload.positions, out_dir / "workspace.html", unit)
+        return ["workspace.json", "workspace.html"]
+    estimate, grid = output.payload
     write_json(out_dir / "workspace.json", workspace_summary(estimate, grid, unit))
     if quick:
         return ["workspace.json"]

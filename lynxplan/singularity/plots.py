@@ -6,10 +6,10 @@ matplotlib is imported inside the functions (Agg backend), never at module impor
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from lynxplan._plotting import pyplot, save_figure
 from lynxplan.singularity.resolved_rate import (
     STRATEGY_NAMES,
     ResolvedRateProblem,
@@ -23,15 +23,6 @@ COLORS = {
     Strategy.DLS: "tab:green",
     Strategy.TR: "tab:purple",
 }
-
-
-def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
 
 
 def plot_runs(
@@ -51,7 +42,7 @@ def plot_manipulability(
     runs: dict[Strategy, ResolvedRateRun], problem: ResolvedRateProblem, path: Path
 ) -> Path:
     """m(q(t)) per strategy (log scale) with the TR thresholds m_bar and m_bar + sigma."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for strategy, run in runs.items():
         ax.semilogy(run.t, np.maximum(run.m, 1e-12), color=COLORS[strategy], label=_name(strategy))
@@ -63,14 +54,14 @@ def plot_manipulability(
     ax.set_title("Manipulability along the path")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend(loc="lower right")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_joint_speeds(
     runs: dict[Strategy, ResolvedRateRun], problem: ResolvedRateProblem, path: Path
 ) -> Path:
     """Joint speeds vs time, one panel per strategy, with the speed limits."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(len(runs), 1, figsize=(8, 2.4 * len(runs)), sharex=True)
     for ax, (strategy, run) in zip(np.atleast_1d(axes), runs.items(), strict=True):
         for joint in range(5):
@@ -84,12 +75,12 @@ def plot_joint_speeds(
         ax.grid(True, alpha=0.3)
     np.atleast_1d(axes)[0].legend(loc="upper right", ncol=5, fontsize=7)
     np.atleast_1d(axes)[-1].set_xlabel("time [s]")
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_tracking_error(runs: dict[Strategy, ResolvedRateRun], path: Path) -> Path:
     """Tool-point distance from the reference vs time (log scale), in [mm]."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for strategy, run in runs.items():
         error = np.maximum(run.position_error * 1e3, 1e-9)
@@ -99,12 +90,12 @@ def plot_tracking_error(runs: dict[Strategy, ResolvedRateRun], path: Path) -> Pa
     ax.set_title("Distance of the tool point from the reference")
     ax.grid(True, which="both", alpha=0.3)
     ax.legend()
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def plot_tool_paths(runs: dict[Strategy, ResolvedRateRun], path: Path) -> Path:
     """Tool paths seen from above (x-y) and from the side (x-z), with the reference, in [mm]."""
-    plt = _pyplot()
+    plt = pyplot()
     fig, (top, side) = plt.subplots(1, 2, figsize=(11, 4.8))
     reference = next(iter(runs.values())).x_ref * 1e3
     for ax, (i, j), title in ((top, (0, 1), "top view"), (side, (0, 2), "side view")):
@@ -119,17 +110,8 @@ def plot_tool_paths(runs: dict[Strategy, ResolvedRateRun], path: Path) -> Path:
     top.plot([0.0], [0.0], "k+", ms=12, mew=2, label="base axis")
     top.set_aspect("equal", adjustable="datalim")
     top.legend(fontsize=8)
-    return _save(fig, path)
+    return save_figure(fig, path)
 
 
 def _name(strategy: Strategy) -> str:
     return STRATEGY_NAMES[strategy]
-
-
-def _save(fig: Any, path: Path) -> Path:
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    import matplotlib.pyplot as plt
-
-    plt.close(fig)
-    return path

@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from lynxplan._plotting import pyplot, save_figure
 from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
@@ -92,10 +93,7 @@ def _draw_plane(ax: Any, setup: Any, axes: tuple[int, int], scale: float) -> Non
 
 def plot_task_view(scenario: Scenario, result: TaskResult, view: str, path: Path) -> Path:
     """The pen path in one view (``"side"`` or ``"top"``), lines red, free motions blue."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     horizontal, vertical, title = VIEWS[view]
     unit = scenario.units.length
@@ -139,10 +137,7 @@ def plot_task_view(scenario: Scenario, result: TaskResult, view: str, path: Path
     ax.autoscale_view()
     ax.grid(True, alpha=0.3)
     ax.legend(loc="best", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def _shade_lines(ax: Any, result: TaskResult) -> None:
@@ -154,10 +149,7 @@ def _shade_lines(ax: Any, result: TaskResult) -> None:
 
 def plot_joints(scenario: Scenario, result: TaskResult, path: Path) -> Path:
     """Joint angles and speeds vs time (straight-line segments shaded red)."""
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     unit = scenario.units.angle
     scale = angle_factor(unit)
@@ -174,10 +166,7 @@ def plot_joints(scenario: Scenario, result: TaskResult, path: Path) -> Path:
     bottom.set_xlabel("time [s]")
     top.legend(loc="upper right", fontsize=8, ncol=5)
     top.set_title(f"{scenario.name or 'task'}: joint trajectories (straight lines shaded)")
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def plot_clearance(
@@ -190,10 +179,7 @@ def plot_clearance(
     primitives) at 100 Hz, the overall minimum marked, the required clearance as a line."""
     if not result.setup.obstacles:
         return None
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    plt = pyplot()
 
     from lynxplan.collision import clearance_profile
 
@@ -225,10 +211,7 @@ def plot_clearance(
     ax.set_title(f"{scenario.name or 'task'}: clearance of the arm to each obstacle")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper right", fontsize=8)
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return save_figure(fig, path, dpi=120)
 
 
 def write_plots(

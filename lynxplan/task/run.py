@@ -103,13 +103,20 @@ def _limit_checks(setup: TaskSetup, samples: Any) -> list[LimitCheck]:
     return checks
 
 
-def execute(scenario: Scenario, setup: TaskSetup | None = None, progress: Any = None) -> TaskResult:
+def execute(
+    scenario: Scenario,
+    setup: TaskSetup | None = None,
+    progress: Any = None,
+    *,
+    compare: bool | None = None,
+) -> TaskResult:
     """Sample the plan, check limits and collisions, compare timings (no files written).
 
     Args:
         scenario: The validated scenario.
         setup: Its resolution (default: resolved again).
         progress: ``callback(done, total)`` for a progress bar, or None.
+        compare: Run the ruckig/toppra comparison (default: the scenario's ``compare``).
     """
     from lynxplan.collision import CollisionWorld, check_trajectory
     from lynxplan.trajectory.plan import segment_reports
@@ -138,7 +145,7 @@ def execute(scenario: Scenario, setup: TaskSetup | None = None, progress: Any = 
     )
     lap("collision", 3)
     comparison = None
-    if scenario.compare:
+    if scenario.compare if compare is None else compare:
         from lynxplan.trajectory.retime import compare_plan
 
         comparison = compare_plan(setup.plan, scenario.sample_rate)

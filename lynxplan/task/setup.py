@@ -14,13 +14,14 @@ import numpy as np
 
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import LynxplanError, ScenarioValueError
+from lynxplan.scenarios.robot import load_path_robot
 from lynxplan.units import angle_factor, length_factor
 from lynxplan.viz import WritingPlane
 
 if TYPE_CHECKING:
     from lynxplan.arm.model import Arm
     from lynxplan.collision.obstacles import Obstacle
-    from lynxplan.scenarios.base import RobotRef
+    from lynxplan.robots import Robot
     from lynxplan.scenarios.task import (
         BoxEntry,
         CylinderEntry,
@@ -28,6 +29,7 @@ if TYPE_CHECKING:
         SphereEntry,
         WaypointEntry,
     )
+    from lynxplan.trajectory.kinematics import PathKinematics
     from lynxplan.trajectory.limits import MotionLimits
     from lynxplan.trajectory.plan import Plan
 
@@ -37,7 +39,8 @@ class TaskSetup:
     """A task scenario in SI units, ready to run.
 
     Attributes:
-        arm: The robot.
+        arm: The robot: the AL5 (``lynxplan.arm.Arm``) or a URDF robot (``lynxplan.Robot``).
+        kinematics: Its FK and path IK for the trajectory layer.
         obstacles: The obstacles, in [m].
         waypoints: Joint angles of each named waypoint, shape (5,), in [rad].
         route: ``(from, to)`` waypoint names of each segment.
@@ -46,7 +49,8 @@ class TaskSetup:
         writing_plane: The writing surface, or None.
     """
 
-    arm: Arm
+    arm: Arm | Robot
+    kinematics: PathKinematics
     obstacles: tuple[Obstacle, ...]
     waypoints: dict[str, np.ndarray]
     route: tuple[tuple[str, str], ...]
@@ -72,7 +76,7 @@ def _resolve(scenario: Scenario) -> TaskSetup:
 
     length = length_factor(scenario.units.length)
     angle = angle_factor(scenario.units.angle)
-    arm = load_robot(scenario.robot)
+    arm, kinematics = load_path_robot(scenario.robot)
     limits = _limits(scenario, arm, angle)
     obstacles = tuple(_obstacles(scenario, length, angle))
     waypoints = {
@@ -89,12 +93,14 @@ def _resolve(scenario: Scenario) -> TaskSetup:
             names = [start, *(f"{start}->{target}#{k}" for k in range(1, len(vias) - 1)), target]
             waypoints.update(zip(names[1:-1], vias[1:-1], strict=True))
             for k in range(len(vias) - 1):
-                piece = _segment(i, entry, vias[k + 1], vias[k], scenario, limits, "free")
+                piece = _segment(
+                    i, entry, vias[k + 1], vias[k], scenario, limits, kinematics, "free"
+                )
                 segments.append(piece)
                 expanded.append((names[k], names[k + 1]))
             q = segments[-1].q_end
             continue
-        segment = _segment(i, entry, waypoints[target], q, scenario, limits)
+        segment = _segment(i, entry, waypoints[target], q, scenario, limits, kinematics)
         segments.append(segment)
         expanded.append((start, target))
         q = segment.q_end
@@ -107,30 +113,11 @@ def _resolve(scenario: Scenario) -> TaskSetup:
             float(wp.tilt) * angle,
             (wp.size[0] * length, wp.size[1] * length),
         )
-    return TaskSetup(arm, obstacles, waypoints, path, limits, Plan(tuple(segments), limits), plane)
+    plan = Plan(tuple(segments), limits, kinematics)
+    return TaskSetup(arm, kinematics, obstacles, waypoints, path, limits, plan, plane)
 
 
-def load_robot(entry: RobotRef) -> Arm:
-    """The arm of the scenario; ScenarioValueError naming the key when it is not usable."""
-    from lynxplan.arm.model import load_arm
-
-    if entry.name not in (None, "al5"):
-        raise _InvalidError(
-            ("robot", "name"),
-            f"robot {entry.name!r}: task scenarios plan with the AL5's analytic IK; valid: al5",
-            entry.name,
-        )
-    try:
-        return load_arm(entry.urdf)
-    except LynxplanError as exc:
-        raise _InvalidError(
-            ("robot", "urdf"),
-            f"{exc}; task scenarios plan with the AL5's analytic IK and need its joint structure",
-            entry.urdf,
-        ) from exc
-
-
-def _limits(scenario: Scenario, arm: Arm, angle: float) -> MotionLimits:
+def _limits(scenario: Scenario, arm: Arm | Robot, angle: float) -> MotionLimits:
     from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK, MotionLimits
 
     entry = scenario.limits
@@ -208,7 +195,9 @@ def _obstacle(
     )
 
 
-def _waypoint(name: str, entry: WaypointEntry, arm: Arm, length: float, angle: float) -> np.ndarray:
+def _waypoint(
+    name: str, entry: WaypointEntry, arm: Arm | Robot, length: float, angle: float
+) -> np.ndarray:
     loc: tuple[str | int, ...] = ("waypoints", name)
     if entry.q is not None:
         q = np.array(entry.q) * angle
@@ -223,16 +212,26 @@ def _waypoint(name: str, entry: WaypointEntry, arm: Arm, length: float, angle: f
     else:
         pose = _approach_pose(np.array(entry.position) * length, np.array(entry.approach))
         key = "position"
+    # The AL5 has the report's branch rule; a URDF robot takes the branch nearest q_reference.
+    report_rule = entry.ik == "report" and not hasattr(arm, "ik_batch")
     try:
         result = arm.ik(
             pose,
             q_reference=reference,
-            select="nearest" if entry.ik == "nearest" else "report",
+            select="report" if report_rule else "nearest",
             approach_only=entry.pose is None,
         )
-        return np.array(result.q)
+        q = np.array(result.q)
     except LynxplanError as exc:
         raise _InvalidError((*loc, key), f"unreachable waypoint: {exc}") from exc
+    if not getattr(result, "reachable", True):  # a URDF robot answers with the nearest solution
+        miss = float(getattr(result, "distance", np.nan))
+        raise _InvalidError(
+            (*loc, key),
+            f"unreachable waypoint: the nearest solution misses it by "
+            f"{miss / length:.6g} (file's length unit)",
+        )
+    return q
 
 
 def _approach_pose(position: np.ndarray, approach: np.ndarray) -> np.ndarray:
@@ -245,7 +244,9 @@ def _approach_pose(position: np.ndarray, approach: np.ndarray) -> np.ndarray:
     return pose
 
 
-def _check_within_limits(q: np.ndarray, arm: Arm, loc: tuple[str | int, ...], angle: float) -> None:
+def _check_within_limits(
+    q: np.ndarray, arm: Arm | Robot, loc: tuple[str | int, ...], angle: float
+) -> None:
     lower, upper = arm.limits.lower, arm.limits.upper
     for j in range(len(q)):
         if not lower[j] - LIMIT_SNAP_TOLERANCE <= q[j] <= upper[j] + LIMIT_SNAP_TOLERANCE:
@@ -285,7 +286,7 @@ def route(scenario: Scenario) -> tuple[tuple[str, str], ...]:
 
 
 def _planned_vias(
-    i: int, entry: Any, q: np.ndarray, target: np.ndarray, arm: Arm, obstacles: Any
+    i: int, entry: Any, q: np.ndarray, target: np.ndarray, arm: Arm | Robot, obstacles: Any
 ) -> np.ndarray:
     """``motion: plan``: the waypoints of a collision-free path planned by
     :func:`lynxplan.plan` (RRT-Connect, shortcut, verified exactly), shape (M, 5), in [rad]."""
@@ -304,6 +305,7 @@ def _segment(
     q: np.ndarray,
     scenario: Scenario,
     limits: MotionLimits,
+    kinematics: PathKinematics,
     motion: Literal["free", "line"] | None = None,
 ) -> Any:
     from lynxplan.trajectory.lspb import LspbTiming
@@ -316,7 +318,7 @@ def _segment(
         timing = None  # the pieces of a planned motion: shortest LSPB each, rest at the vias
     spec = SegmentSpec(kind, target_q=target, timing=timing, mode=entry.orientation)
     try:
-        return build_plan(q, [spec], limits).segments[0]
+        return build_plan(q, [spec], limits, kinematics).segments[0]
     except LynxplanError as exc:
         raise _InvalidError(
             ("segments", i), f"{entry.motion} motion to {entry.to!r}: {exc}"

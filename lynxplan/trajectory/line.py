@@ -11,7 +11,9 @@ one of four modes:
 - ``drive``: the report's appendix method, Paul's drive transform (translation, rotation about a
   unit vector, rotation about the approach axis).
 
-Every sample is solved by the analytic IK, on the branch continuous with the previous sample. The
+Every sample is solved by the arm's analytic IK (:mod:`lynxplan.trajectory.kinematics`: the AL5's
+kernels by default, or a yaw-pitch-pitch-pitch-roll robot from URDF), on the branch continuous
+with the previous sample. The
 full-SO(3) modes pass through orientations the arm cannot reach: the IK projects them (the
 residual is reported) and its roll can leave the joint limits (reported as violations).
 """
@@ -25,12 +27,10 @@ from typing import Literal
 import numpy as np
 
 from lynxplan import guards
-from lynxplan.arm.geometry import ArmGeometry
-from lynxplan.arm.ik import select_continuous, solve_ik_batch
-from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import PATH_GRID_POINTS
-from lynxplan.exceptions import InputError, PathNotFollowableError
+from lynxplan.exceptions import InputError
 from lynxplan.trajectory.free import JointSamples, as_configuration, check_timing
+from lynxplan.trajectory.kinematics import Al5Kinematics, PathKinematics, PathTargets
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.lspb import LspbTiming, unit_lspb
 from lynxplan.trajectory.rotations import (
@@ -44,14 +44,6 @@ from lynxplan.trajectory.timing import auto_timing_path
 
 OrientationMode = Literal["consistent", "slerp", "lerp", "drive"]
 ORIENTATION_MODES: tuple[str, ...] = ("consistent", "slerp", "lerp", "drive")
-
-_GEOMETRY = ArmGeometry()
-
-
-def _pitch(T: np.ndarray) -> float:
-    """Approach pitch in the arm plane through the tool point: ``a = (u sin psi, -cos psi)``."""
-    radial = T[:2, 3] / max(math.hypot(T[0, 3], T[1, 3]), 1e-300)
-    return math.atan2(float(radial @ T[:2, 2]), -float(T[2, 2]))
 
 
 def _wrap(angle: float) -> float:
@@ -99,6 +91,9 @@ class LineSegment:
         mode: Orientation interpolation mode.
         limits: Joint limits (the IK prefers branches within them).
         grid: The joint path solved on a uniform grid (derivatives for rates and timing).
+        roll: Roll joint angle at the start and the end (``consistent`` mode), in [rad].
+        pitch: Approach pitch at the start and the end (``consistent`` mode), in [rad].
+        kinematics: The arm's FK and path IK.
     """
 
     T_start: np.ndarray
@@ -111,6 +106,7 @@ class LineSegment:
     grid: PathGrid
     roll: tuple[float, float]
     pitch: tuple[float, float]
+    kinematics: PathKinematics
 
     kind = "line"
 
@@ -119,34 +115,24 @@ class LineSegment:
         """Segment duration ``tt``, in [s]."""
         return self.timing.tt
 
-    def targets(self, s: np.ndarray) -> tuple[np.ndarray, np.ndarray | None]:
-        """Interpolated tool targets at ``s`` (m,): poses (m, 4, 4) and, in ``consistent`` mode,
-        the reference configurations (m, 5) carrying the roll (else None)."""
+    def targets(self, s: np.ndarray) -> np.ndarray:
+        """Interpolated tool targets at ``s`` (m,): poses (m, 4, 4) (in ``consistent`` mode only
+        the translation is meaningful: the approach pitch and the roll are interpolated)."""
         s = np.asarray(s, dtype=float)
         p0, p1 = self.T_start[:3, 3], self.T_end[:3, 3]
         out = np.zeros((s.size, 4, 4))
         out[:, 3, 3] = 1.0
         out[:, :3, 3] = p0 + np.multiply.outer(s, p1 - p0)
         if self.mode == "consistent":
-            return self._consistent_targets(s, out)
+            out[:, :3, :3] = np.eye(3)
+            return out
         if self.mode == "drive":
-            return drive_transforms(self.T_start, self.T_end, s), None
+            return drive_transforms(self.T_start, self.T_end, s)
         quat0 = matrix_to_quaternion(self.T_start[:3, :3])
         quat1 = matrix_to_quaternion(self.T_end[:3, :3])
         blend = slerp if self.mode == "slerp" else component_blend
         out[:, :3, :3] = quaternion_to_matrix(blend(quat0, quat1, s))
-        return out, None
-
-    def _consistent_targets(self, s: np.ndarray, out: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        pitch = self.pitch[0] + s * (self.pitch[1] - self.pitch[0])
-        azimuth = np.arctan2(out[:, 1, 3], out[:, 0, 3])
-        # Only the approach column matters (5-D target); the roll is q5 of the reference.
-        out[:, 0, 2] = np.cos(azimuth) * np.sin(pitch)
-        out[:, 1, 2] = np.sin(azimuth) * np.sin(pitch)
-        out[:, 2, 2] = -np.cos(pitch)
-        reference = np.zeros((s.size, 5))
-        reference[:, 4] = self.roll[0] + s * (self.roll[1] - self.roll[0])
-        return out, reference
+        return out
 
     def solve(
         self, s: np.ndarray, q_before: np.ndarray
@@ -198,26 +184,13 @@ class LineSegment:
 def _solve_line(
     segment: LineSegment, s: np.ndarray, q_before: np.ndarray
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    poses, reference = segment.targets(s)
-    ik = solve_ik_batch(
-        poses,
-        q_reference=reference,
-        approach_only=reference is not None,
-        limits=segment.limits.joint_limits,
-    )
-    failed = np.flatnonzero(ik.status != 0)
-    if failed.size:
-        first = int(failed[0])
-        raise PathNotFollowableError(float(s[first]), float(ik.reach_miss[first]))
-    q, branch = select_continuous(ik.q, ik.within_limits, np.asarray(q_before, dtype=float))
-    return q, branch, np.asarray(ik.orientation_error)
-
-
-def _nearest_solution(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.ndarray:
-    ik = solve_ik_batch(T[None], limits=limits.joint_limits)
-    if ik.status[0] != 0:
-        raise PathNotFollowableError(1.0, float(ik.reach_miss[0]))
-    return np.asarray(select_continuous(ik.q, ik.within_limits, q_near)[0][0])
+    targets = PathTargets(segment.targets(s))
+    if segment.mode == "consistent":
+        pitch = segment.pitch[0] + s * (segment.pitch[1] - segment.pitch[0])
+        roll = segment.roll[0] + s * (segment.roll[1] - segment.roll[0])
+        targets = PathTargets(targets.poses, pitch, roll)
+    ik = segment.kinematics.solve(targets, q_before, segment.limits, s)
+    return ik.q, ik.branch, ik.residual
 
 
 def line_segment(
@@ -228,6 +201,7 @@ def line_segment(
     *,
     mode: str = "consistent",
     limits: MotionLimits | None = None,
+    kinematics: PathKinematics | None = None,
 ) -> LineSegment:
     """A straight-line segment between two tool poses, solved on the grid.
 
@@ -238,6 +212,7 @@ def line_segment(
         timing: Fixed LSPB timing, or None for the shortest within ``limits``.
         mode: ``consistent`` (default), ``slerp``, ``lerp`` or ``drive``.
         limits: Joint limits (default: URDF + documented defaults).
+        kinematics: The arm (default: the AL5's closed-form kernels).
 
     Raises:
         InputError: unknown mode, or ``T_start`` far from the FK of ``q_start``.
@@ -248,17 +223,18 @@ def line_segment(
             f"unknown orientation mode {mode!r}; valid modes: {', '.join(ORIENTATION_MODES)}"
         )
     lim = limits or MotionLimits()
+    kin = kinematics or Al5Kinematics()
     T0 = guards.poses("T_start", T_start, batch=False).copy()
     T1 = guards.poses("T_end", T_end, batch=False).copy()
     qs = as_configuration(q_start, "q_start")
     check_timing(timing)
-    gap = float(np.linalg.norm(forward_kinematics(qs)[:3, 3] - T0[:3, 3]))
+    gap = float(np.linalg.norm(kin.tool_poses(qs[None])[0, :3, 3] - T0[:3, 3]))
     if gap > 1e-6:
         raise InputError(f"T_start is {gap * 1000:.4g} mm from the tool point of q_start")
-    q_end_pose = _nearest_solution(T1, qs, lim)
-    pitch0 = _pitch(T0)
-    pitch = (pitch0, pitch0 + _wrap(_pitch(T1) - pitch0))
-    roll = (float(qs[4]), float(q_end_pose[4]))
+    q_end_pose = kin.nearest(T1, qs, lim)
+    pitch0 = kin.pitch(T0, qs)
+    pitch = (pitch0, pitch0 + _wrap(kin.pitch(T1, q_end_pose) - pitch0))
+    roll = (float(qs[-1]), float(q_end_pose[-1]))
     s_grid = np.linspace(0.0, 1.0, PATH_GRID_POINTS)
     # Grid first with a placeholder timing, then the real timing (auto-timing needs the grid).
     draft = LineSegment(
@@ -272,6 +248,7 @@ def line_segment(
         PathGrid(s_grid, s_grid, s_grid, s_grid),
         roll,
         pitch,
+        kin,
     )
     q_grid = draft.joint_path(s_grid)
     dq, ddq = _derivatives(q_grid, s_grid[1] - s_grid[0])
@@ -282,4 +259,4 @@ def line_segment(
         timing = auto_timing_path(s_grid, dq, ddq, lim.velocity, lim.acceleration)
     q_end = q_grid[-1].copy()
     q_end.setflags(write=False)
-    return LineSegment(T0, T1, qs, q_end, timing, mode, lim, grid, roll, pitch)
+    return LineSegment(T0, T1, qs, q_end, timing, mode, lim, grid, roll, pitch, kin)

@@ -9,14 +9,12 @@ computed from the samples, not predicted.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Literal, NamedTuple
 
 import numpy as np
 
 from lynxplan import guards
-from lynxplan.arm.ik import select_continuous, solve_ik_batch
-from lynxplan.arm.kinematics import forward_kinematics
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import InputError, PathNotFollowableError
 from lynxplan.trajectory.free import (
@@ -26,6 +24,7 @@ from lynxplan.trajectory.free import (
     check_timing,
     free_segment,
 )
+from lynxplan.trajectory.kinematics import Al5Kinematics, PathKinematics
 from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.line import LineSegment, line_segment
 from lynxplan.trajectory.lspb import LspbTiming
@@ -83,10 +82,12 @@ class Plan:
     Attributes:
         segments: The segments, in order.
         limits: The joint limits the plan was built with.
+        kinematics: The arm (FK of the samples; default: the AL5's closed form).
     """
 
     segments: tuple[Segment, ...]
     limits: MotionLimits
+    kinematics: PathKinematics = field(default_factory=Al5Kinematics)
 
     @property
     def start_times(self) -> np.ndarray:
@@ -128,21 +129,25 @@ class Plan:
             q,
             np.concatenate([p.qd for p in parts]),
             np.concatenate([p.qdd for p in parts]),
-            forward_kinematics(q),
+            self.kinematics.tool_poses(q),
             index,
             np.concatenate([p.branch for p in parts]),
             np.concatenate([p.orientation_residual for p in parts]),
         )
 
 
-def _ik_nearest(T: np.ndarray, q_near: np.ndarray, limits: MotionLimits) -> np.ndarray:
-    ik = solve_ik_batch(T[None], limits=limits.joint_limits)
-    if ik.status[0] != 0:
-        raise PathNotFollowableError(1.0, float(ik.reach_miss[0]), "target pose")
-    return np.asarray(select_continuous(ik.q, ik.within_limits, q_near)[0][0])
+def _ik_nearest(
+    T: np.ndarray, q_near: np.ndarray, limits: MotionLimits, kinematics: PathKinematics
+) -> np.ndarray:
+    try:
+        return kinematics.nearest(T, q_near, limits)
+    except PathNotFollowableError as exc:
+        raise PathNotFollowableError(1.0, exc.reach_miss, "target pose") from exc
 
 
-def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) -> Segment:
+def _build_segment(
+    i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits, kinematics: PathKinematics
+) -> Segment:
     if (spec.target_q is None) == (spec.target_pose is None):
         raise InputError(f"segment {i}: give exactly one of target_q and target_pose")
     pose = np.eye(4)  # replaced below when the target is a pose
@@ -154,17 +159,16 @@ def _build_segment(i: int, spec: SegmentSpec, q: np.ndarray, lim: MotionLimits) 
         target = (
             as_configuration(spec.target_q, f"segments[{i}].target_q")
             if spec.target_q is not None
-            else _ik_nearest(pose, q, lim)
+            else _ik_nearest(pose, q, lim, kinematics)
         )
         return free_segment(q, target, spec.timing, limits=lim)
     if spec.kind == "line":
-        T_end = (
-            forward_kinematics(as_configuration(spec.target_q, f"segments[{i}].target_q"))
-            if spec.target_q is not None
-            else pose
-        )
+        if spec.target_q is not None:
+            target_q = as_configuration(spec.target_q, f"segments[{i}].target_q")
+            pose = kinematics.tool_poses(target_q[None])[0]
+        T_start = kinematics.tool_poses(q[None])[0]
         return line_segment(
-            forward_kinematics(q), T_end, q, spec.timing, mode=spec.mode, limits=lim
+            T_start, pose, q, spec.timing, mode=spec.mode, limits=lim, kinematics=kinematics
         )
     raise InputError(f"segment {i}: unknown kind {spec.kind!r}; valid kinds: free, line")
 
@@ -173,6 +177,7 @@ def build_plan(
     q_start: np.ndarray | list[float],
     specs: list[SegmentSpec] | tuple[SegmentSpec, ...],
     limits: MotionLimits | None = None,
+    kinematics: PathKinematics | None = None,
 ) -> Plan:
     """Chain segments from ``q_start``; each starts at the previous one's end configuration.
 
@@ -180,6 +185,7 @@ def build_plan(
         q_start: Start configuration, shape (5,), in [rad].
         specs: The segments.
         limits: Joint limits for auto-timing and IK (default: URDF + documented defaults).
+        kinematics: The arm (default: the AL5's closed-form kernels).
 
     Raises:
         InputError: a spec gives neither or both targets, or there is no segment.
@@ -196,17 +202,18 @@ def build_plan(
         if not isinstance(spec, SegmentSpec):
             raise InputError(f"specs[{i}] must be a SegmentSpec. Got: {type(spec).__name__}")
     guards.check_size("plan segments", len(specs))
+    kin = kinematics or Al5Kinematics()
     q = as_configuration(q_start, "q_start")
     segments: list[Segment] = []
     for i, spec in enumerate(specs):
         try:
-            segment = _build_segment(i, spec, q, lim)
+            segment = _build_segment(i, spec, q, lim, kin)
         except PathNotFollowableError as exc:
             what = f"segment {i} ({spec.kind})"
             raise PathNotFollowableError(exc.s, exc.reach_miss, what) from exc
         segments.append(segment)
         q = segment.q_end
-    return Plan(tuple(segments), lim)
+    return Plan(tuple(segments), lim, kin)
 
 
 class SegmentReport(NamedTuple):
@@ -263,7 +270,7 @@ def segment_reports(plan: Plan, samples: PlanSamples) -> list[SegmentReport]:
                 samples.tool[mask, :3, 3], seg.T_start[:3, 3], seg.T_end[:3, 3]
             )
         flat = int(np.argmax(np.abs(qd))) if qd.size else 0
-        k, joint = divmod(flat, 5)
+        k, joint = divmod(flat, q.shape[1])
         reports.append(
             SegmentReport(
                 i,

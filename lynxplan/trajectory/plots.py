@@ -3,10 +3,10 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
+from lynxplan._plotting import pyplot, save_figure
 from lynxplan.trajectory.plan import Plan, PlanSamples
 from lynxplan.trajectory.retime import METHODS, PlanComparison, SegmentComparison
 
@@ -19,15 +19,6 @@ _STYLE = {
 }
 
 
-def _pyplot() -> Any:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-
-    return plt
-
-
 def plot_joint_profiles(comparison: SegmentComparison, joint: int, path: Path) -> None:
     """Angle, velocity and acceleration of one joint vs time, one curve per method.
 
@@ -36,7 +27,7 @@ def plot_joint_profiles(comparison: SegmentComparison, joint: int, path: Path) -
         joint: 0-based joint index (1 = q2, the report's figure).
         path: PNG file to write.
     """
-    plt = _pyplot()
+    plt = pyplot()
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
     labels = ("angle [deg]", "velocity [deg/s]", "acceleration [deg/s²]")
     for name in METHODS:
@@ -52,14 +43,12 @@ def plot_joint_profiles(comparison: SegmentComparison, joint: int, path: Path) -
     axes[-1].set_xlabel("time since segment start [s]")
     axes[0].legend(fontsize=8)
     fig.suptitle(f"q{joint + 1}(t), segment {comparison.segment} ({comparison.kind})")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def plot_tool_xyz(plan: Plan, samples: PlanSamples, segment: int, path: Path) -> None:
     """Tool point x, y, z vs time on one segment (the report's x(t) figure), in [mm]."""
-    plt = _pyplot()
+    plt = pyplot()
     mask = samples.segment == segment
     t = samples.t[mask] - plan.start_times[segment]
     fig, axes = plt.subplots(3, 1, figsize=(8, 7), sharex=True)
@@ -70,14 +59,12 @@ def plot_tool_xyz(plan: Plan, samples: PlanSamples, segment: int, path: Path) ->
     axes[-1].set_xlabel("time since segment start [s]")
     kind = plan.segments[segment].kind
     fig.suptitle(f"tool point, segment {segment} ({kind})")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)
 
 
 def plot_durations(comparison: PlanComparison, path: Path) -> None:
     """Grouped bar chart of each segment's duration per method."""
-    plt = _pyplot()
+    plt = pyplot()
     count = len(comparison.segments)
     fig, ax = plt.subplots(figsize=(max(6.0, 0.8 * count + 2), 4.5))
     width = 0.8 / len(METHODS)
@@ -93,6 +80,4 @@ def plot_durations(comparison: PlanComparison, path: Path) -> None:
     ax.grid(True, axis="y", alpha=0.3)
     ax.legend(fontsize=8)
     ax.set_title("segment durations per time-parameterisation")
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save_figure(fig, path)

@@ -36,7 +36,7 @@ class Input(ScenarioModel):
     x: float
 
 
-def run(scenario: Input) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False) -> KindOutput:
     return KindOutput({"square": scenario.x**2, "positive": scenario.x > 0}, f"{scenario.x}^2")
 
 

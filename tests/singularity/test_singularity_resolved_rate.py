@@ -19,6 +19,7 @@ from lynxplan.scenarios.singularity import build_problem
 from lynxplan.singularity.measures import manipulability, task_jacobian
 from lynxplan.singularity.resolved_rate import (
     PathReference,
+    RateOutputs,
     ResolvedRateProblem,
     ResolvedRateRun,
     Strategy,
@@ -132,6 +133,11 @@ def test_tr_escape_gain_pushes_out_of_the_singular_region(arm: Arm) -> None:
     assert tr.m[-1] >= 0.95 * params.m_bar
     pinv = run_resolved_rate(problem, "pinv")
     np.testing.assert_allclose(pinv.q[-1], q0, atol=1e-12)
+
+
+def test_a_run_holds_the_kernel_outputs_in_their_order() -> None:
+    # Runs are built as ResolvedRateRun(strategy, task, *outputs): the two field lists must agree.
+    assert ResolvedRateRun._fields[2:] == RateOutputs._fields
 
 
 def test_k1_values_and_continuity() -> None:

@@ -74,10 +74,16 @@ def test_ok_task_report_segments(ok_run):
     assert report["details"]["sample_count"] == 26001
     assert report["details"]["collision_check"]["checked_pairs"] == 16  # 8 primitives x 2 obstacles
     assert "coal" in report["details"]["collision_check"]["accuracy"]
-    table = report["details"]["timing_comparison"]
+    assert report["details"]["timing_comparison"] is None  # --quick skips the comparison
+    assert report["details"]["units"]["length"] == "m"
+
+
+def test_ok_task_timing_comparison_when_not_quick(ok_run):
+    full = run_scenario(OK_TASK)  # no output folder; not quick: ruckig and toppra run
+    assert full.metrics == ok_run[0].metrics
+    table = full.details["timing_comparison"]
     assert table["totals"]["lspb"]["total_duration_s"] == pytest.approx(26.0, abs=1e-9)
     assert table["totals"]["ruckig"]["segments_covered"] == 6  # the free segments
-    assert report["details"]["units"]["length"] == "m"
 
 
 def test_reported_minimum_is_the_exact_distance_and_a_true_minimum(ok_run):

@@ -162,9 +162,15 @@ def test_line_leaving_the_reach_is_located_at_its_segment(tmp_path):
         _load(tmp_path, data)
 
 
-def test_robot_other_than_al5_is_rejected_at_run_time(tmp_path):
-    with pytest.raises(ScenarioError, match=r"robot\.name: .*AL5's analytic IK"):
-        _load(tmp_path, scenario_dict(robot={"name": "so101"}))
+def test_robot_outside_the_five_joint_family_is_rejected_at_run_time(tmp_path):
+    from example_robot_data.robots_loader import getModelPath
+
+    ur5 = "ur_description/urdf/ur5_robot.urdf"
+    data = scenario_dict(robot={"urdf": f"{getModelPath(ur5)}/{ur5}", "tool": "tool0"})
+    with pytest.raises(ScenarioError, match=r"robot\.urdf: robot .* has 6 joints; task and"):
+        _load(tmp_path, data)
+    with pytest.raises(ScenarioError, match=r"robot\.name: unknown robot 'so102'"):
+        _load(tmp_path, scenario_dict(robot={"name": "so102"}))
 
 
 def test_pose_and_approach_waypoints_are_solved_by_ik(tmp_path):

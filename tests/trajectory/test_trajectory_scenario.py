@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 from lynxplan.cli import main
@@ -16,22 +17,27 @@ SHIPPED = ["free_motion.yaml", "straight_line.yaml"]
 
 
 @pytest.mark.parametrize("name", SHIPPED)
-def test_shipped_scenarios_run_and_hold_their_expectations(name: str, tmp_path: Path) -> None:
-    outcome = run_scenario(SCENARIOS / name, tmp_path, quick=True)
+def test_shipped_scenarios_run_and_hold_their_expectations(name: str) -> None:
+    outcome = run_scenario(SCENARIOS / name)  # not quick: with the ruckig/toppra comparison
     assert outcome.ok, outcome.failed_expectations
-    report = json.loads((tmp_path / "report.json").read_text())
-    segment = report["details"]["segments"][0]
+    segment = outcome.details["segments"][0]
     assert segment["tt"] == 3.0 and segment["ta"] == 1.0
     assert segment["limit_violation_samples"] == 0
     assert {"lspb", "lspb_auto", "toppra"} <= set(segment["comparison"])
-    assert report["details"]["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
+    assert outcome.details["plan_comparison"]["lspb"]["total_duration_s"] == pytest.approx(3.0)
 
 
-def test_free_motion_report_matches_the_lspb_formulas(tmp_path: Path) -> None:
-    run_scenario(SCENARIOS / "free_motion.yaml", tmp_path, quick=True)
-    stats = json.loads((tmp_path / "report.json").read_text())["details"]["segments"][0][
-        "comparison"
-    ]
+def test_quick_runs_skip_the_comparison_and_keep_the_metrics(tmp_path: Path) -> None:
+    full = run_scenario(SCENARIOS / "straight_line.yaml")
+    quick = run_scenario(SCENARIOS / "straight_line.yaml", tmp_path, quick=True)
+    assert quick.metrics == full.metrics
+    report = json.loads((tmp_path / "report.json").read_text())
+    assert "comparison" not in report["details"]["segments"][0]
+    assert "plan_comparison" not in report["details"]
+
+
+def test_free_motion_report_matches_the_lspb_formulas() -> None:
+    stats = run_scenario(SCENARIOS / "free_motion.yaml").details["segments"][0]["comparison"]
     # dA / T with T = tt - ta = 2 s and dA / (T ta) for the report's example.
     delta = [1.2, 0.9, 0.68, 1.0, 0.0]
     assert stats["lspb"]["peak_velocity_rad_s"] == pytest.approx([d / 2 for d in delta], abs=1e-9)
@@ -144,3 +150,27 @@ def test_cli_runs_a_scenario_and_reports_bad_input(tmp_path: Path, capsys) -> No
     bad = _write(tmp_path, "segments: [{motion: free, to_q: [0, 0, 0, 0, 0], tt: -1, ta: 0.5}]")
     assert main(["run", str(bad), "--out", str(tmp_path / "x")]) == 2
     assert "segments[0].tt: Input should be greater than 0 (line 3)" in capsys.readouterr().err
+
+
+def test_trajectory_of_the_so101_follows_its_line_and_limits(tmp_path: Path) -> None:
+    import lynxplan
+
+    robot = lynxplan.load_robot("so101")
+    start = robot.ik(position=[0.17, 0.05, 0.03], approach=[0, 0, -1], roll=-1.57).q
+    end = robot.ik(position=[0.24, -0.05, 0.03], approach=[0, 0, -1], roll=-1.57).q
+    body = {
+        "kind": "trajectory",
+        "robot": {"name": "so101"},
+        "start": start.tolist(),
+        "sample_rate": 500,
+        "segments": [{"motion": "line", "to_q": end.tolist(), "tt": 1.5, "ta": 0.4}],
+        "expect": {"max_line_deviation": "<= 1e-9 m", "joint_limits_respected": True},
+    }
+    outcome = run_scenario(body, tmp_path, quick=True)
+    assert outcome.ok, outcome.failed_expectations
+    table = np.loadtxt(tmp_path / "trajectory.csv", delimiter=",", skiprows=1)
+    np.testing.assert_allclose(robot.fk(table[:, 1:6])[:, :3, 3], table[:, -3:], atol=1e-12)
+    # Out of the SO-101's limits (within the AL5's): named at run time by key path.
+    body["start"] = [0.0, 0.0, 0.0, 0.0, 3.0]
+    with pytest.raises(ScenarioError, match=r"start\[4\]: q5 = 3 rad is outside its joint limits"):
+        run_scenario(body)
