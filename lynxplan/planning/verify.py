@@ -239,9 +239,7 @@ class _PathCheck:
         return ClearanceRecord(clearance, link, geometry, other, where, sample)
 
 
-_VERIFIERS: weakref.WeakKeyDictionary[CollisionWorld, ExactVerifier] = (
-    weakref.WeakKeyDictionary()
-)
+_VERIFIERS: weakref.WeakKeyDictionary[CollisionWorld, ExactVerifier] = weakref.WeakKeyDictionary()
 
 
 def verifier_of(world: CollisionWorld) -> ExactVerifier:
