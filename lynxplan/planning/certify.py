@@ -40,7 +40,7 @@ MIN_STEP = 1e-4
 STEP_GROWTH = 1.9
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def sphere_gap(p: int, model: Any, scratch: Any) -> float:
     """Bounding-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
 
@@ -75,7 +75,7 @@ def sphere_gap(p: int, model: Any, scratch: Any) -> float:
     return box_gap
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any) -> None:
     q = scratch[7]
     for j in range(q_a.shape[0]):
@@ -85,7 +85,7 @@ def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: A
         primitive_pose(g, model, scratch)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _bound_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any
 ) -> float:

@@ -120,7 +120,7 @@ class ValidityChecker:
 _compose = _multiply  # out = a @ b for 4x4 rigid transforms (the collision kernels' own)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
     """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4).
 
@@ -147,7 +147,7 @@ def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
         _compose(world[parents[j]], local, world[j])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def primitive_pose(g: int, model: Any, scratch: Any) -> None:
     """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
     _compose(scratch[0][model[4][g]], model[5][g], scratch[3][g])
@@ -205,7 +205,7 @@ def _separating_axis_gap(
     return best
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _point_box_distance(p: np.ndarray, pose: np.ndarray, half: np.ndarray) -> float:
     """Distance from point p (3,) to a solid box of pose (4, 4) and half sizes (3,) (0 inside)."""
     total = 0.0
@@ -217,7 +217,7 @@ def _point_box_distance(p: np.ndarray, pose: np.ndarray, half: np.ndarray) -> fl
     return math.sqrt(total)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def pair_bound(p: int, model: Any, scratch: Any) -> float:
     """Lower bound of pair p's distance at the poses in scratch[3], in [m]."""
     prim_half, prim_radius, pairs = model[6], model[7], model[8]
