@@ -32,7 +32,7 @@ import numba
 import numpy as np
 
 from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
-from lynxplan.planning.validity import joint_poses, pair_bound, primitive_pose
+from lynxplan.planning.validity import centre_gap, joint_poses, pair_bound, primitive_pose
 
 #: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.
 MIN_STEP = 1e-4
@@ -49,22 +49,15 @@ def sphere_gap(p: int, model: Any, scratch: Any) -> float:
     obstacle exactly.
     """
     prim_radius, pairs = model[7], model[8]
-    kinds, centres, poses_b, obstacle_half = model[10], model[11], model[12], model[13]
+    kinds, poses_b, obstacle_half = model[10], model[12], model[13]
     poses = scratch[3]
     a, b = pairs[p, 0], pairs[p, 1]
     pa = poses[a]
     if pairs[p, 2] == 1:
-        pb = poses[b]
-        dx, dy, dz = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
-        gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - prim_radius[b]
-        return gap
-    c = centres[b]
-    if kinds[b] == OBSTACLE_SPHERE:
-        dx, dy, dz = c[0] - pa[0, 3], c[1] - pa[1, 3], c[2] - pa[2, 3]
-        centre_gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - obstacle_half[b, 0]
-        centre_gap -= prim_radius[a]
-        return centre_gap
+        return centre_gap(pa, prim_radius[a], poses[b], prim_radius[b])
     pose = poses_b[b]
+    if kinds[b] == OBSTACLE_SPHERE:
+        return centre_gap(pa, prim_radius[a], pose, obstacle_half[b, 0])
     total = 0.0
     dx, dy, dz = pa[0, 3] - pose[0, 3], pa[1, 3] - pose[1, 3], pa[2, 3] - pose[2, 3]
     for k in range(3):

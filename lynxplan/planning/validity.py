@@ -218,6 +218,15 @@ def _point_box_distance(p: np.ndarray, pose: np.ndarray, half: np.ndarray) -> fl
 
 
 @numba.njit(cache=True, inline="always")
+def centre_gap(pa: np.ndarray, ra: float, pb: np.ndarray, rb: float) -> float:
+    """Gap of two bounding spheres: centres at the translations of poses pa, pb (4, 4), radii
+    ra, rb, in [m] (a lower bound of the distance of anything inside them)."""
+    dx, dy, dz = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
+    gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - ra - rb
+    return gap
+
+
+@numba.njit(cache=True, inline="always")
 def pair_bound(p: int, model: Any, scratch: Any) -> float:
     """Lower bound of pair p's distance at the poses in scratch[3], in [m]."""
     prim_half, prim_radius, pairs = model[6], model[7], model[8]
@@ -227,8 +236,7 @@ def pair_bound(p: int, model: Any, scratch: Any) -> float:
     pa = poses[a]
     if pairs[p, 2] == 1:
         pb = poses[b]
-        dx, dy, dz = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
-        gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - prim_radius[b]
+        gap = centre_gap(pa, prim_radius[a], pb, prim_radius[b])
         if gap < SAT_SKIP_DISTANCE:
             sat = _separating_axis_gap(pa, prim_half[a], pb, prim_half[b], scratch[8])
             gap = max(gap, sat)
