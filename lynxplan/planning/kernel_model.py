@@ -58,7 +58,8 @@ def world_pairs(world: CollisionWorld) -> np.ndarray:
 
 def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
     """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
-    counters (edge checks, advancement steps, pair bounds evaluated)."""
+    counters (edge checks, advancement steps, pair bounds evaluated) and the pair that last
+    failed a quick state test."""
     joints, prims, pairs, nq = len(model[0]), len(model[4]), len(model[8]), model[9].shape[1]
     del prims
     return (
@@ -71,7 +72,7 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         np.empty(pairs),
         np.empty(nq),
         np.empty((3, 3)),
-        np.zeros(3, dtype=np.int64),
+        np.zeros(4, dtype=np.int64),
         np.zeros(len(model[4]), dtype=np.int64),
     )
 

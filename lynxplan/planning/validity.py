@@ -271,6 +271,30 @@ def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
 
 
 @numba.njit(cache=True)
+def point_is_clear(
+    q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any, clearance: float
+) -> bool:
+    """Whether every pair's bound exceeds clearance + STALL_DISTANCE at q_a + s (q_b - q_a).
+
+    A quick rejection before an edge walk (a blocked edge usually has a blocked point there):
+    it stops at the first failing pair, trying first the pair that failed last (scratch[9][3]).
+    """
+    q = scratch[7]
+    for j in range(q_a.shape[0]):
+        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
+    primitive_poses(q, model, scratch)
+    count, last = model[8].shape[0], scratch[9][3]
+    threshold = clearance + STALL_DISTANCE
+    if last < count and pair_bound(last, model, scratch) <= threshold:
+        return False
+    for p in range(count):
+        if p != last and pair_bound(p, model, scratch) <= threshold:
+            scratch[9][3] = p
+            return False
+    return True
+
+
+@numba.njit(cache=True)
 def edge_fraction(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> float:

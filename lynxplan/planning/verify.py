@@ -41,9 +41,6 @@ from lynxplan.planning.validity import state_bounds
 
 #: Bisection levels of one interval before it is reported as not certified (grazing contact).
 MAX_BISECTION_DEPTH = 40
-#: A chain step first tries this multiple of (exact distance / motion rate); the two-sided test
-#: allows up to 2 when the distance does not shrink.
-GUESS_REACH = 1.8
 #: First capacity of the schedule's rows (doubled while too small).
 _ROWS = 1024
 
@@ -181,16 +178,19 @@ class _PathCheck:
         segment, parameter, pair = self.verifier.schedule(self.path)
         poses = self.verifier.poses(self.path, segment, parameter)
         where = (segment + parameter).tolist()
-        starts = np.flatnonzero(
-            np.r_[True, (segment[1:] != segment[:-1]) | (pair[1:] != pair[:-1])]
-        ).tolist()
-        for lo, hi in zip(starts, [*starts[1:], len(pair)], strict=True):
-            k, p = int(segment[lo]), int(pair[lo])
-            chain = _Chain(self, poses[lo:hi], parameter[lo:hi], where[lo:hi], k, p)
-            chain.walk()
+        pairs = pair.tolist()
+        distance = np.array(
+            [self.distance_at(poses[r], where[r], pairs[r]) for r in range(len(pairs))]
+        )
+        self._waypoint_minimum()
+        if self.contact is not None or len(pairs) < 2:
+            return
+        same = (segment[1:] == segment[:-1]) & (pair[1:] == pair[:-1])
+        motion = self.rates[segment[1:], pair[1:]] * (parameter[1:] - parameter[:-1])
+        for r in np.flatnonzero(same & (distance[:-1] + distance[1:] <= motion)).tolist():
+            self.bisect(int(segment[r]), pairs[r], float(parameter[r]), float(parameter[r + 1]))
             if self.contact is not None or not self.certified:
                 return
-        self._waypoint_minimum()
 
     def bisect(self, k: int, pair: int, s0: float, s1: float) -> None:
         """Certify pair on [s0, s1] of segment k by bisection with exact distances."""
@@ -237,61 +237,6 @@ class _PathCheck:
         link, geometry, other = self.verifier.world.pair_names(pair)
         sample = int(where) if where == int(where) else -1
         return ClearanceRecord(clearance, link, geometry, other, where, sample)
-
-
-class _Chain:
-    """One pair's candidate rows on one segment (parameters ascending, from 0 to 1), walked
-    with exact distances: from a certified row, the next queried row is the farthest candidate
-    within ``GUESS_REACH * d / L`` (most of the time the two-sided test then passes: one query
-    per step); when it does not, the farthest candidate within ``d / L`` (the test passes by the
-    exact distance's Lipschitz bound), else the next candidate (it passes when the exact
-    distances are at least the planner's bounds), else bisection. Every interval is decided by
-    the exact test alone; the guesses only choose where to query."""
-
-    def __init__(
-        self,
-        check: _PathCheck,
-        poses: np.ndarray,
-        parameter: np.ndarray,
-        where: list[float],
-        k: int,
-        pair: int,
-    ) -> None:
-        self.check, self.poses, self.parameter, self.where = check, poses, parameter, where
-        self.k, self.pair, self.rate = k, pair, float(check.rates[k, pair])
-
-    def distance(self, row: int) -> float:
-        return self.check.distance_at(self.poses[row], self.where[row], self.pair)
-
-    def _farthest(self, row: int, reach: float) -> int:
-        """The last candidate within ``reach`` of row's parameter, at least the next one."""
-        last = int(np.searchsorted(self.parameter, self.parameter[row] + reach, "right")) - 1
-        return max(row + 1, min(last, len(self.parameter) - 1))
-
-    def _passes(self, row: int, d_row: float, other: int, d_other: float) -> bool:
-        span = self.parameter[other] - self.parameter[row]
-        return bool(d_row > 0.0 and d_other > 0.0 and d_row + d_other > self.rate * span)
-
-    def walk(self) -> None:
-        row, d_row = 0, self.distance(0)
-        last = len(self.parameter) - 1
-        while row < last and d_row > 0.0:
-            tried = set()
-            for reach in (GUESS_REACH * d_row / self.rate, d_row / self.rate, 0.0):
-                other = self._farthest(row, reach)
-                if other in tried:
-                    continue
-                tried.add(other)
-                d_other = self.distance(other)
-                if self._passes(row, d_row, other, d_other) or d_other <= 0.0:
-                    break
-            else:
-                self.check.bisect(
-                    self.k, self.pair, float(self.parameter[row]), float(self.parameter[other])
-                )
-            if self.check.contact is not None or not self.check.certified:
-                return
-            row, d_row = other, d_other
 
 
 _VERIFIERS: weakref.WeakKeyDictionary[CollisionWorld, ExactVerifier] = weakref.WeakKeyDictionary()
