@@ -5,7 +5,12 @@ from __future__ import annotations
 from typing import Any
 
 import orjson
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import Response
+
+from lynxplan.exceptions import LynxplanError
 
 PROBLEM_MEDIA_TYPE = "application/problem+json"
 
@@ -66,3 +71,39 @@ def problem_response(
         media_type=PROBLEM_MEDIA_TYPE,
         headers=headers,
     )
+
+
+def install_error_handlers(app: FastAPI) -> None:
+    """Answer every error of ``app`` as problem+json (never a traceback)."""
+
+    @app.exception_handler(Problem)
+    async def on_problem(request: Request, exc: Problem) -> Response:
+        return problem_response(exc.status, exc.detail, exc.field, request.url.path)
+
+    @app.exception_handler(StarletteHTTPException)
+    async def on_http(request: Request, exc: StarletteHTTPException) -> Response:
+        detail = exc.detail if isinstance(exc.detail, str) else str(exc.status_code)
+        if exc.status_code == 404:
+            detail = f"no route {request.method} {request.url.path}"
+        return problem_response(exc.status_code, detail, None, request.url.path)
+
+    @app.exception_handler(RequestValidationError)
+    async def on_validation(request: Request, exc: RequestValidationError) -> Response:
+        first = exc.errors()[0] if exc.errors() else {"loc": (), "msg": "invalid request"}
+        loc = [str(part) for part in first.get("loc", ())][1:]
+        return problem_response(
+            422, str(first.get("msg", "invalid")), ".".join(loc) or None, request.url.path
+        )
+
+    @app.exception_handler(LynxplanError)
+    async def on_domain(request: Request, exc: LynxplanError) -> Response:
+        field = getattr(exc, "name", None)
+        return problem_response(
+            422, str(exc), field if isinstance(field, str) else None, request.url.path
+        )
+
+    @app.exception_handler(Exception)
+    async def on_crash(request: Request, exc: Exception) -> Response:
+        return problem_response(
+            500, f"internal error ({type(exc).__name__})", None, request.url.path
+        )
