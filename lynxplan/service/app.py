@@ -12,11 +12,13 @@ from importlib import resources
 import numpy as np
 from fastapi import FastAPI
 from starlette.responses import HTMLResponse, Response
+from starlette.types import ASGIApp
 
 from lynxplan import __version__
 from lynxplan.service import compute, wire
 from lynxplan.service.auth import TokenMiddleware
 from lynxplan.service.config import ServiceConfig
+from lynxplan.service.fastpath import FastPath
 from lynxplan.service.jobs import RunManager
 from lynxplan.service.kinematics_routes import add_kinematics_routes
 from lynxplan.service.problems import Problem, install_error_handlers
@@ -24,13 +26,15 @@ from lynxplan.service.robots import describe_robot, get_robot, robot_names
 from lynxplan.service.run_routes import add_run_routes
 
 API_VERSION = 1
-#: Hot routes served by plain Starlette routes in front of their FastAPI twins (see
-#: :func:`_fast_routes`); each endpoint takes only the request.
+#: Hot routes served by :class:`~lynxplan.service.fastpath.FastPath` in front of their FastAPI
+#: twins; each endpoint takes only the request.
 FAST_PATHS = ("/ik", "/fk", "/check", "/trajectory")
 
 
-def create_app(config: ServiceConfig) -> FastAPI:
-    """The application; its run manager starts with the app's lifespan."""
+def create_app(config: ServiceConfig) -> ASGIApp:
+    """The ASGI application: the token check (when configured) in front of the hot routes' fast
+    path (:mod:`.fastpath`) in front of the FastAPI app; its run manager starts with the
+    lifespan."""
     state: dict[str, RunManager] = {}
 
     @asynccontextmanager
@@ -53,8 +57,6 @@ def create_app(config: ServiceConfig) -> FastAPI:
         redoc_url=None,
     )
     install_error_handlers(app)
-    if config.token:
-        app.add_middleware(TokenMiddleware, token=config.token)
 
     def runs() -> RunManager:
         return state["runs"]
@@ -105,25 +107,8 @@ def create_app(config: ServiceConfig) -> FastAPI:
         media = mimetypes.guess_type(name)[0] or "application/octet-stream"
         return Response(_static(name), media_type=media)
 
-    _fast_routes(app, FAST_PATHS)
-    return app
-
-
-def _fast_routes(app: FastAPI, paths: tuple[str, ...]) -> None:
-    """Serve ``paths`` by plain Starlette routes placed first (the FastAPI routes stay, for the
-    OpenAPI document only): FastAPI's route matching and dependency solving cost more than the
-    whole IK of one pose. Their endpoints take the request only and decode it themselves."""
-    from fastapi.routing import APIRoute
-    from starlette.routing import Route
-
-    fast = [
-        Route(
-            route.path, route.endpoint, methods=sorted(route.methods or ()), include_in_schema=False
-        )
-        for route in app.router.routes
-        if isinstance(route, APIRoute) and route.path in paths
-    ]
-    app.router.routes[:0] = fast
+    front = FastPath(app, FAST_PATHS)
+    return TokenMiddleware(front, config.token) if config.token else front
 
 
 def _static(name: str) -> bytes:

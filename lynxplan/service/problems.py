@@ -73,37 +73,32 @@ def problem_response(
     )
 
 
+def error_response(exc: Exception, method: str, path: str) -> Response:
+    """The problem+json answer to any exception raised while serving ``method path`` (one
+    mapping for the FastAPI routes and the fast path): Problem as given, HTTP errors with their
+    status, validation and domain errors 422, anything else 500 without a traceback."""
+    if isinstance(exc, Problem):
+        return problem_response(exc.status, exc.detail, exc.field, path)
+    if isinstance(exc, StarletteHTTPException):
+        detail = exc.detail if isinstance(exc.detail, str) else str(exc.status_code)
+        if exc.status_code == 404:
+            detail = f"no route {method} {path}"
+        return problem_response(exc.status_code, detail, None, path)
+    if isinstance(exc, RequestValidationError):
+        first = exc.errors()[0] if exc.errors() else {"loc": (), "msg": "invalid request"}
+        loc = [str(part) for part in first.get("loc", ())][1:]
+        return problem_response(422, str(first.get("msg", "invalid")), ".".join(loc) or None, path)
+    if isinstance(exc, LynxplanError):
+        field = getattr(exc, "name", None)
+        return problem_response(422, str(exc), field if isinstance(field, str) else None, path)
+    return problem_response(500, f"internal error ({type(exc).__name__})", None, path)
+
+
 def install_error_handlers(app: FastAPI) -> None:
     """Answer every error of ``app`` as problem+json (never a traceback)."""
 
-    @app.exception_handler(Problem)
-    async def on_problem(request: Request, exc: Problem) -> Response:
-        return problem_response(exc.status, exc.detail, exc.field, request.url.path)
+    async def on_error(request: Request, exc: Exception) -> Response:
+        return error_response(exc, request.method, request.url.path)
 
-    @app.exception_handler(StarletteHTTPException)
-    async def on_http(request: Request, exc: StarletteHTTPException) -> Response:
-        detail = exc.detail if isinstance(exc.detail, str) else str(exc.status_code)
-        if exc.status_code == 404:
-            detail = f"no route {request.method} {request.url.path}"
-        return problem_response(exc.status_code, detail, None, request.url.path)
-
-    @app.exception_handler(RequestValidationError)
-    async def on_validation(request: Request, exc: RequestValidationError) -> Response:
-        first = exc.errors()[0] if exc.errors() else {"loc": (), "msg": "invalid request"}
-        loc = [str(part) for part in first.get("loc", ())][1:]
-        return problem_response(
-            422, str(first.get("msg", "invalid")), ".".join(loc) or None, request.url.path
-        )
-
-    @app.exception_handler(LynxplanError)
-    async def on_domain(request: Request, exc: LynxplanError) -> Response:
-        field = getattr(exc, "name", None)
-        return problem_response(
-            422, str(exc), field if isinstance(field, str) else None, request.url.path
-        )
-
-    @app.exception_handler(Exception)
-    async def on_crash(request: Request, exc: Exception) -> Response:
-        return problem_response(
-            500, f"internal error ({type(exc).__name__})", None, request.url.path
-        )
+    for kind in (Problem, StarletteHTTPException, RequestValidationError, LynxplanError, Exception):
+        app.add_exception_handler(kind, on_error)
