@@ -3,7 +3,8 @@
 Two servers run as subprocesses on this machine: a bare FastAPI app with one JSON endpoint (the
 floor: what any endpoint costs here) and ``lynxplan serve``. Figures, measured in one run:
 sequential latency p50/p99 of the floor and of ``/ik`` for one pose (keep-alive connection),
-requests/s of ``/ik`` with 32 concurrent connections, the server time of one 100,000-pose binary
+requests/s of ``/ik`` with 32 concurrent connections (wall clock, and per CPU second of the
+server process: its rate per core), the server time of one 100,000-pose binary
 ``/ik`` batch (``Server-Timing``), and the OK task (quick) run through the service, warm. The
 load generator is Python on the same cores, so the throughput figure is a lower bound.
 """
@@ -145,6 +146,29 @@ async def _throughput(port: int, path: str, body: bytes, seconds: float) -> floa
     return done / elapsed
 
 
+def _cpu_seconds(pid: int) -> float:
+    """User + system CPU time of a process so far, in [s] (NaN where ``/proc`` is missing)."""
+    try:
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+    except OSError:
+        return float("nan")
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def _throughput_per_core(
+    process: subprocess.Popen[bytes], port: int, path: str, body: bytes, seconds: float
+) -> tuple[float, float]:
+    """Requests/s with :data:`CONNECTIONS` connections, and requests per CPU second of the
+    server process (the rate one fully busy core would serve: the load generator shares this
+    machine's cores, so the wall-clock rate alone understates the server)."""
+    cpu = _cpu_seconds(process.pid)
+    start = time.monotonic()
+    rate = asyncio.run(_throughput(port, path, body, seconds))
+    elapsed = time.monotonic() - start
+    used = _cpu_seconds(process.pid) - cpu
+    return rate, rate * elapsed / used if used > 0 else float("nan")
+
+
 def _batch_server_ms(client: Any, poses: np.ndarray, verify: str) -> float:
     """Server time of one binary /ik batch, in [ms] (its ``Server-Timing`` header)."""
     response = client.post(
@@ -194,8 +218,10 @@ def run(quick: bool) -> list[Figure]:
         )
         try:
             bare, ik = _latencies([(floor_port, "/echo"), (service_port, "/ik")], ik_body, count)
-            bare_rate = asyncio.run(_throughput(floor_port, "/echo", ik_body, seconds))
-            rate = asyncio.run(_throughput(service_port, "/ik", ik_body, seconds))
+            bare_rate, bare_core = _throughput_per_core(
+                floor, floor_port, "/echo", ik_body, seconds
+            )
+            rate, core_rate = _throughput_per_core(service, service_port, "/ik", ik_body, seconds)
             with httpx.Client(base_url=service_url) as client:
                 poses = arm.fk(
                     np.random.default_rng(0).uniform(
@@ -227,7 +253,6 @@ def run(quick: bool) -> list[Figure]:
     f50, f99 = float(np.percentile(bare, 50)), float(np.percentile(bare, 99))
     batch_ms = float(np.median(server_ms["true"]))
     bare_batch_ms = float(np.median(server_ms["false"]))
-    cores = os.cpu_count() or 1
     return [
         Figure(SECTION, "bare FastAPI floor p50", f50, "ms"),
         Figure(SECTION, "bare FastAPI floor p99", f99, "ms"),
@@ -236,8 +261,10 @@ def run(quick: bool) -> list[Figure]:
         Figure(SECTION, "/ik p50 / floor p50", p50 / f50, "x", "<= 1.3", p50 / f50 <= 1.3),
         Figure(SECTION, f"bare floor requests/s, {CONNECTIONS} connections", bare_rate, "req/s"),
         Figure(SECTION, f"/ik requests/s, {CONNECTIONS} connections", rate, "req/s"),
-        Figure(SECTION, "/ik requests/s per core", rate / cores, "req/s", ">= 4000",
-               rate / cores >= 4000),
+        Figure(SECTION, "bare floor requests per server CPU second", bare_core, "req/s"),
+        Figure(SECTION, "/ik requests per server CPU second (per core)", core_rate, "req/s",
+               ">= 4000", core_rate >= 4000),
+        Figure(SECTION, "/ik / floor requests per CPU second", core_rate / bare_core, "x"),
         Figure(SECTION, f"/ik {BATCH:,}-pose binary batch, server", bare_batch_ms, "ms",
                "<= 100", bare_batch_ms <= 100),
         Figure(SECTION, f"/ik {BATCH:,}-pose batch + FK residual of 4 branches", batch_ms, "ms"),

@@ -22,7 +22,7 @@ from lynxplan.planning.shortcut import DEFAULT_SHORTCUT_ITERATIONS, shortcut
 from lynxplan.planning.space import JointSpace
 from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE, METHODS, TimedPath, time_parameterize
 from lynxplan.planning.validity import STALL_DISTANCE, ValidityChecker
-from lynxplan.planning.verify import VerificationReport, require_clear, verify_path
+from lynxplan.planning.verify import VerificationReport, require_clear, verifier_of
 from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK
 
 #: Default required clearance between the robot and anything else, in [m].
@@ -174,6 +174,7 @@ class Planner:
             self.world = CollisionWorld(robot, obstacles, self_collision=True)
         self.space = JointSpace.of(robot)
         self.checker = ValidityChecker(self.world, self.options.clearance)
+        self.verifier = verifier_of(self.world)
         nq = self.space.dimension
         self.velocity = np.array(robot.limits.velocity, dtype=float)
         self.acceleration = np.broadcast_to(
@@ -249,7 +250,7 @@ class Planner:
             self.checker, found.path, seed=seed, iterations=self.options.shortcut_iterations
         )
         shortened = time.perf_counter()
-        report = verify_path(self.world, path, self.options.clearance)
+        report = self.verifier.verify(path, self.options.clearance)
         verified = time.perf_counter()
         timed = time_parameterize(
             path,

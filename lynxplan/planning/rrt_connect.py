@@ -31,7 +31,7 @@ import numpy as np
 
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.validity import ValidityChecker, edge_fraction
+from lynxplan.planning.validity import ValidityChecker, edge_fraction, point_is_clear
 
 #: Kernel status codes.
 RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2
@@ -153,7 +153,9 @@ def rrt_connect_kernel(
         fraction = min(1.0, step / distance)
         for j in range(nq):
             new[j] = nodes[a, near, j] + fraction * (sample[j] - nodes[a, near, j])
-        if edge_fraction(nodes[a, near], new, model, scratch, clearance) < 1.0:
+        if not point_is_clear(nodes[a, near], new, 1.0, model, scratch, clearance) or (
+            edge_fraction(nodes[a, near], new, model, scratch, clearance) < 1.0
+        ):
             meta[0] = b
             continue
         added = _add(nodes, parents, counts, a, new, near)

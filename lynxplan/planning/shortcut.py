@@ -22,7 +22,7 @@ import numba
 import numpy as np
 
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.validity import ValidityChecker, edge_fraction
+from lynxplan.planning.validity import ValidityChecker, edge_fraction, point_is_clear
 
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
@@ -94,7 +94,9 @@ def shortcut_kernel(
         i2 = _point_at(path, cumulative, count, u2, second)
         if i1 == i2:
             continue
-        if edge_fraction(first, second, model, scratch, clearance) < 1.0:
+        if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
+            edge_fraction(first, second, model, scratch, clearance) < 1.0
+        ):
             continue
         idle = 0
         # New path: path[0..i1], first, second, path[i2+1..count-1].

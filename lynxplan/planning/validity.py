@@ -28,7 +28,7 @@ Edges (conservative advancement)
     unit ``s``. For a self pair only the joints that move one body and not the other count
     (the distance depends on the relative pose only; common ancestors move both rigidly), and a
     fixed cylinder coaxial with the first joint (the base) makes that joint irrelevant
-    (:func:`_pair_rates`). The edge is walked with the largest
+    (:func:`lynxplan.planning.kernel_model.pair_rates`). The edge is walked with the largest
     such step until ``s = 1``, or stopped where a bound comes within :data:`STALL_DISTANCE` of the
     clearance. Every certified part of an edge is collision-free for the real geometry with
     distance >= ``clearance``: no sampling resolution, nothing skipped between samples.
@@ -46,8 +46,13 @@ import numba
 import numpy as np
 
 from lynxplan.collision._kernels import _multiply
-from lynxplan.collision.obstacles import BoxObstacle, CylinderObstacle, SphereObstacle
 from lynxplan.collision.world import CollisionWorld
+from lynxplan.planning.kernel_model import (
+    OBSTACLE_SPHERE,
+    kernel_model,
+    make_scratch,
+    planner_pairs,
+)
 
 #: An edge walk stops when a pair's bound is within this of the required clearance, in [m]:
 #: every step then advances by at least this over the pair's motion rate (no endless creeping).
@@ -57,8 +62,6 @@ STALL_DISTANCE = 2e-4
 SAT_SKIP_DISTANCE = 0.05
 #: The separating-axis bound tries the 9 edge-edge axes only below this face-axis gap, in [m].
 EDGE_AXES_BELOW = 0.02
-#: Obstacle kinds of the kernel.
-OBSTACLE_BOX, OBSTACLE_SPHERE = 0, 1
 
 
 class ValidityChecker:
@@ -79,29 +82,9 @@ class ValidityChecker:
     def __init__(self, world: CollisionWorld, clearance: float) -> None:
         self.clearance = float(clearance)
         self.nq = int(world.model.nq)
-        axes, index_q, parents, placements, prim_joints, prim_placements = world._kernel_joints
-        half = np.array([_box_half_extents(p.kind, p.half_extents) for p in world.links])
-        pairs, names = _pairs(world)
+        pairs, names = planner_pairs(world)
         self.pair_names = tuple(names)
-        kinds, centres, rotations, obstacle_half, obstacle_radius = _obstacle_arrays(world)
-        arrays = (
-            axes.astype(np.int64),
-            index_q.astype(np.int64),
-            parents.astype(np.int64),
-            placements,
-            prim_joints.astype(np.int64),
-            prim_placements,
-            half,
-            np.linalg.norm(half, axis=1),
-            pairs,
-            _pair_rates(world, pairs),
-            kinds,
-            centres,
-            rotations,
-            obstacle_half,
-            obstacle_radius,
-        )
-        self.model = tuple(np.ascontiguousarray(a) for a in arrays)
+        self.model = kernel_model(world, pairs)
         self.scratch = make_scratch(self.model)
 
     def pair_bounds(self, q: np.ndarray) -> np.ndarray:
@@ -131,145 +114,13 @@ class ValidityChecker:
         )
 
 
-def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
-    """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
-    counters (edge checks, advancement steps, pair bounds evaluated)."""
-    joints, prims, pairs, nq = len(model[0]), len(model[4]), len(model[8]), model[9].shape[1]
-    del prims
-    return (
-        np.empty((joints, 4, 4)),
-        np.empty((4, 4)),
-        np.zeros((4, 4)),
-        np.empty((len(model[4]), 4, 4)),
-        np.empty(pairs),
-        np.empty(pairs),
-        np.empty(pairs),
-        np.empty(nq),
-        np.empty((3, 3)),
-        np.zeros(3, dtype=np.int64),
-        np.zeros(len(model[4]), dtype=np.int64),
-    )
-
-
-def _box_half_extents(kind: str, half: np.ndarray) -> np.ndarray:
-    if kind in ("box", "mesh"):  # a mesh primitive is its hull, inside this box
-        return np.array(half, dtype=float)
-    radius, half_length = float(half[0]), float(half[1])
-    return np.array([radius, radius, half_length])
-
-
-def _pairs(world: CollisionWorld) -> tuple[np.ndarray, list[tuple[str, str]]]:
-    """Checked pairs: moving primitive vs obstacle, and non-adjacent primitive pairs."""
-    rows, names = [], []
-    links = world.links
-    for o, obstacle in enumerate(world.obstacles):
-        for g, link in enumerate(links):
-            if link.joint != 0:
-                rows.append((g, o, 0))
-                names.append((link.geometry, obstacle.name))
-    parents = list(world.model.parents)
-    for a in range(len(links)):
-        for b in range(a + 1, len(links)):
-            ja, jb = links[a].joint, links[b].joint
-            if ja == jb or parents[ja] == jb or parents[jb] == ja:
-                continue  # same or adjacent bodies: touching by design (URDF adjacency)
-            rows.append((a, b, 1))
-            names.append((links[a].geometry, f"self:{links[b].geometry}"))
-    return np.array(rows, dtype=np.int64).reshape(-1, 3), names
-
-
-def _ancestors(model: Any, joint: int) -> set[int]:
-    """Configuration indices of the joints that move a body on ``joint``."""
-    found = set()
-    while joint > 0:
-        found.add(int(model.joints[joint].idx_q))
-        joint = int(model.parents[joint])
-    return found
-
-
-def _symmetric_about_root_axis(world: CollisionWorld, g: int) -> int | None:
-    """The configuration index of the first joint if fixed primitive g is a cylinder coaxial
-    with it (turning that joint then cannot change any distance to g), else None."""
-    model, link = world.model, world.links[g]
-    if link.joint != 0 or link.kind != "cylinder" or model.njoints < 2 or model.parents[1] != 0:
-        return None
-    axis_index = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}.get(
-        model.joints[1].shortname()
-    )
-    if axis_index is None:
-        return None
-    placement = np.array(model.jointPlacements[1].homogeneous)
-    joint_axis, joint_origin = placement[:3, axis_index], placement[:3, 3]
-    cylinder_axis, centre = link.placement[:3, 2], link.placement[:3, 3]
-    offset = centre - joint_origin
-    off_axis = offset - (offset @ joint_axis) * joint_axis
-    if np.linalg.norm(np.cross(joint_axis, cylinder_axis)) > 1e-12:
-        return None
-    if np.linalg.norm(off_axis) > 1e-12:
-        return None
-    return int(model.joints[1].idx_q)
-
-
-def _pair_rates(world: CollisionWorld, pairs: np.ndarray) -> np.ndarray:
-    """Motion of each pair per radian of each joint, shape (P, nq), in [m/rad].
-
-    Obstacle pair: the primitive's reach about each joint. Self pair: the distance between two
-    bodies depends only on their relative pose, so joints that move both (common ancestors)
-    do not count; each other joint counts with the reach of the body it moves. A fixed
-    cylinder coaxial with the first joint (the AL5's base) is symmetric about it: that joint
-    does not count either.
-    """
-    model = world.model
-    rates = np.zeros((len(pairs), model.nq))
-    for p, (a, b, is_self) in enumerate(pairs.tolist()):
-        first = world.links[a]
-        if not is_self:
-            rates[p] = first.reach
-            continue
-        second = world.links[b]
-        only_a = _ancestors(model, first.joint) - _ancestors(model, second.joint)
-        only_b = _ancestors(model, second.joint) - _ancestors(model, first.joint)
-        for j in only_a:
-            rates[p, j] += first.reach[j]
-        for j in only_b:
-            rates[p, j] += second.reach[j]
-        for g in (a, b):
-            symmetric = _symmetric_about_root_axis(world, g)
-            if symmetric is not None:
-                rates[p, symmetric] = 0.0
-    return rates
-
-
-def _obstacle_arrays(world: CollisionWorld) -> tuple[np.ndarray, ...]:
-    count = len(world.obstacles)
-    kinds = np.zeros(count, dtype=np.int64)
-    centres = np.zeros((count, 3))
-    poses = np.zeros((count, 4, 4))
-    half = np.zeros((count, 3))
-    for o, obstacle in enumerate(world.obstacles):
-        centres[o] = obstacle.centre
-        poses[o, :3, :3] = np.asarray(obstacle.rotation)
-        poses[o, :3, 3] = obstacle.centre
-        poses[o, 3, 3] = 1.0
-        if isinstance(obstacle, BoxObstacle):
-            half[o] = obstacle.size / 2.0
-        elif isinstance(obstacle, SphereObstacle):
-            kinds[o] = OBSTACLE_SPHERE
-            half[o] = obstacle.radius
-        elif isinstance(obstacle, CylinderObstacle):
-            half[o] = (obstacle.radius, obstacle.radius, obstacle.length / 2.0)
-    # Bounding-sphere radius of each obstacle (a sphere's own radius).
-    radius = np.where(kinds == OBSTACLE_SPHERE, half[:, 0], np.linalg.norm(half, axis=1))
-    return kinds, centres, poses, half, radius
-
-
 # -- compiled kernels ---------------------------------------------------------------------------
 
 
 _compose = _multiply  # out = a @ b for 4x4 rigid transforms (the collision kernels' own)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
     """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4).
 
@@ -296,7 +147,7 @@ def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
         _compose(world[parents[j]], local, world[j])
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def primitive_pose(g: int, model: Any, scratch: Any) -> None:
     """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
     _compose(scratch[0][model[4][g]], model[5][g], scratch[3][g])
@@ -354,7 +205,7 @@ def _separating_axis_gap(
     return best
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _point_box_distance(p: np.ndarray, pose: np.ndarray, half: np.ndarray) -> float:
     """Distance from point p (3,) to a solid box of pose (4, 4) and half sizes (3,) (0 inside)."""
     total = 0.0
@@ -366,7 +217,16 @@ def _point_box_distance(p: np.ndarray, pose: np.ndarray, half: np.ndarray) -> fl
     return math.sqrt(total)
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
+def centre_gap(pa: np.ndarray, ra: float, pb: np.ndarray, rb: float) -> float:
+    """Gap of two bounding spheres: centres at the translations of poses pa, pb (4, 4), radii
+    ra, rb, in [m] (a lower bound of the distance of anything inside them)."""
+    dx, dy, dz = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
+    gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - ra - rb
+    return gap
+
+
+@numba.njit(cache=True, inline="always")
 def pair_bound(p: int, model: Any, scratch: Any) -> float:
     """Lower bound of pair p's distance at the poses in scratch[3], in [m]."""
     prim_half, prim_radius, pairs = model[6], model[7], model[8]
@@ -376,8 +236,7 @@ def pair_bound(p: int, model: Any, scratch: Any) -> float:
     pa = poses[a]
     if pairs[p, 2] == 1:
         pb = poses[b]
-        dx, dy, dz = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
-        gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - prim_radius[b]
+        gap = centre_gap(pa, prim_radius[a], pb, prim_radius[b])
         if gap < SAT_SKIP_DISTANCE:
             sat = _separating_axis_gap(pa, prim_half[a], pb, prim_half[b], scratch[8])
             gap = max(gap, sat)
@@ -409,6 +268,30 @@ def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
     for p in range(model[8].shape[0]):
         best = min(best, pair_bound(p, model, scratch))
     return best
+
+
+@numba.njit(cache=True)
+def point_is_clear(
+    q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any, clearance: float
+) -> bool:
+    """Whether every pair's bound exceeds clearance + STALL_DISTANCE at q_a + s (q_b - q_a).
+
+    A quick rejection before an edge walk (a blocked edge usually has a blocked point there):
+    it stops at the first failing pair, trying first the pair that failed last (scratch[9][3]).
+    """
+    q = scratch[7]
+    for j in range(q_a.shape[0]):
+        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
+    primitive_poses(q, model, scratch)
+    count, last = model[8].shape[0], scratch[9][3]
+    threshold = clearance + STALL_DISTANCE
+    if last < count and pair_bound(last, model, scratch) <= threshold:
+        return False
+    for p in range(count):
+        if p != last and pair_bound(p, model, scratch) <= threshold:
+            scratch[9][3] = p
+            return False
+    return True
 
 
 @numba.njit(cache=True)

@@ -1,12 +1,19 @@
 """Exact verification of planned paths with coal, and the exact start/goal collision test.
 
 The planner's own checker is conservative but approximate (bounding boxes, separating axes). A
-returned path is therefore re-checked by :func:`lynxplan.collision.check_trajectory` — exact
-coal distances between the URDF collision geometry and the obstacles, and between every pair of
-primitives on non-adjacent links, with its certification between waypoints (conservative
-advancement + bisection: a bound on the motion of any point of the robot between two checked
-configurations is kept below the distances found there; proof in
-:mod:`lynxplan.collision.check`).
+returned path is therefore re-checked with exact coal distances between the URDF collision
+geometry and the obstacles, and between every pair of primitives on non-adjacent links, by
+conservative advancement on each straight joint segment, pair by pair: a pair is certified on
+``[s0, s1]`` when lower bounds ``d0``, ``d1`` of its distance at both ends exceed, together, the
+bound ``L (s1 - s0)`` on the motion of any of its points in between (``L``:
+:func:`lynxplan.planning.kernel_model.pair_rates`; proof in :mod:`lynxplan.collision.check`).
+The lower bounds are exact coal distances, except for a pair whose bounding-sphere gaps (a
+primitive inside its circumscribed sphere) already prove the whole segment. Where to query is
+chosen by :mod:`lynxplan.planning.certify` from the planner's tight bounds, so a clear path
+needs few exact queries (one per pair and waypoint near an obstacle, plus about ``L / 2d``
+along a segment that stays ``d`` from it); an interval that the exact distances do not prove
+is bisected with exact distances (a distance <= 0 is a contact). Nothing is sampled at a fixed
+resolution and nothing between checked configurations is left unproven.
 
 Self-collision pairs ("allowed pairs" from the URDF adjacency): two primitives are *not*
 checked when they hang on the same joint or on a parent/child pair of joints (they touch by
@@ -21,18 +28,21 @@ itself, densely.
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import numpy as np
 
-from lynxplan.collision import ClearanceRecord, CollisionWorld, check_trajectory
+from lynxplan.collision import ClearanceRecord, CollisionWorld
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
+from lynxplan.planning.certify import configuration_poses, schedule, segment_rates
+from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pairs
+from lynxplan.planning.validity import state_bounds
 
-#: Before the exact check, each path segment is split so that no point of the robot moves more
-#: than this between two checked configurations, in [m]: pairs farther apart than that are then
-#: certified by the collision world's sphere bounds alone, and the exact (coal) queries go to the
-#: close pairs (2 cm halves the check's time on the suite against checking bare waypoints).
-VERIFY_MOTION_STEP = 0.02
+#: Bisection levels of one interval before it is reported as not certified (grazing contact).
+MAX_BISECTION_DEPTH = 40
+#: First capacity of the schedule's rows (doubled while too small).
+_ROWS = 1024
 
 
 @dataclass(frozen=True)
@@ -41,11 +51,11 @@ class VerificationReport:
 
     Attributes:
         collision_free: No contact anywhere along the path, every interval certified.
-        min_clearance: Smallest exact distance found at the waypoints and at the points the
-            certification probed between them (link, obstacle, where), in [m]; its ``time`` is
-            the path parameter (waypoint index, fractional between waypoints). In between, the
-            path is certified collision-free, and the planner's own certificate guarantees at
-            least ``required_clearance`` everywhere.
+        min_clearance: Smallest exact distance found at the waypoints and at the configurations
+            the certification queried (link, obstacle, where), in [m]; its ``time`` is the path
+            parameter (waypoint index, fractional between waypoints). In between, the path is
+            certified collision-free, and the planner's own certificate guarantees at least
+            ``required_clearance`` everywhere.
         required_clearance: The planner's required clearance, in [m].
         self_collision_pairs: Number of self-collision pairs checked.
         obstacle_pairs: Number of primitive/obstacle pairs checked.
@@ -62,6 +72,184 @@ class VerificationReport:
     refined_intervals: int
 
 
+class ExactVerifier:
+    """Exact (coal) verification of joint paths in one collision world, set up once.
+
+    Args:
+        world: The collision world; every one of its pairs is checked.
+    """
+
+    def __init__(self, world: CollisionWorld) -> None:
+        self.world = world
+        self.pairs = world_pairs(world)
+        self.model = kernel_model(world, self.pairs)
+        self.scratch = make_scratch(self.model)
+        # coal objects built once by the world; transforms updated in place, one result reused.
+        self._functors = world._coal_pairs
+        self._obstacle_poses = world._coal_obstacle_poses
+        self._request = world._coal_request
+        self._result = world._coal_result_type()
+        self._link_poses = [type(t)() for t in world._coal_link_poses]
+        self._rows = tuple(tuple(int(v) for v in row) for row in self.pairs.tolist())
+        self.queries = 0
+
+    def exact(self, poses: np.ndarray, pair: int) -> float:
+        """coal's signed distance of one pair at primitive poses (G, 4, 4), in [m]."""
+        a, b, is_self = self._rows[pair]
+        first = self._link_poses[a]
+        first.setRotation(poses[a, :3, :3])
+        first.setTranslation(poses[a, :3, 3])
+        if is_self:
+            second = self._link_poses[b]
+            second.setRotation(poses[b, :3, :3])
+            second.setTranslation(poses[b, :3, 3])
+        else:
+            second = self._obstacle_poses[b]
+        self._result.clear()
+        self.queries += 1
+        return float(self._functors[pair](first, second, self._request, self._result))
+
+    def poses(self, path: np.ndarray, segment: np.ndarray, parameter: np.ndarray) -> np.ndarray:
+        """Primitive poses at path parameters (segment, s): shape (R, G, 4, 4)."""
+        out = np.empty((len(segment), len(self.world.links), 4, 4))
+        configuration_poses(path, segment, parameter, self.model, self.scratch, out)
+        return out
+
+    def schedule(self, path: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """The rows (segment, s, pair) to query exactly (:func:`certify.schedule`)."""
+        capacity = _ROWS
+        while True:
+            segment = np.empty(capacity, dtype=np.int64)
+            parameter = np.empty(capacity)
+            pair = np.empty(capacity, dtype=np.int64)
+            rows = schedule(path, self.model, self.scratch, (segment, parameter, pair))
+            if rows >= 0:
+                return segment[:rows], parameter[:rows], pair[:rows]
+            capacity *= 4
+
+    def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
+        """Certify a piecewise-linear path (N, nq), in [rad]; see :func:`verify_path`."""
+        path = np.ascontiguousarray(waypoints, dtype=float)
+        if len(path) == 1:
+            path = np.vstack([path, path])
+        self.queries = 0
+        check = _PathCheck(self, path)
+        check.run()
+        if check.contact is not None:
+            raise PathVerificationError(check.contact)
+        if not check.certified:
+            raise PathVerificationError("an interval could not be certified (grazing contact)")
+        self_pairs = int(self.world.pair_is_self.sum())
+        return VerificationReport(
+            collision_free=True,
+            min_clearance=check.minimum(),
+            required_clearance=clearance,
+            self_collision_pairs=self_pairs,
+            obstacle_pairs=self.world.pair_count - self_pairs,
+            exact_queries=self.queries,
+            refined_intervals=check.refined,
+        )
+
+
+class _PathCheck:
+    """One path's certification: exact distances by path parameter, bisection, the minimum."""
+
+    def __init__(self, verifier: ExactVerifier, path: np.ndarray) -> None:
+        self.verifier, self.path = verifier, path
+        self.rates = segment_rates(path, verifier.model)  # (M - 1, P)
+        self.known: dict[tuple[float, int], float] = {}
+        self.contact: str | None = None
+        self.certified = True
+        self.refined = 0
+
+    def distance_at(self, poses: np.ndarray, where: float, pair: int) -> float:
+        key = (where, pair)
+        if key not in self.known:
+            self.known[key] = self.verifier.exact(poses, pair)
+            if self.known[key] <= 0.0 and self.contact is None:
+                link, geometry, other = self.verifier.world.pair_names(pair)
+                self.contact = (
+                    f"{link} ({geometry}) touches {other} at path parameter {where:.4f}, "
+                    f"penetration {-self.known[key] * 1e3:.4f} mm"
+                )
+        return self.known[key]
+
+    def run(self) -> None:
+        segment, parameter, pair = self.verifier.schedule(self.path)
+        poses = self.verifier.poses(self.path, segment, parameter)
+        where = (segment + parameter).tolist()
+        pairs = pair.tolist()
+        distance = np.array(
+            [self.distance_at(poses[r], where[r], pairs[r]) for r in range(len(pairs))]
+        )
+        self._waypoint_minimum()
+        if self.contact is not None or len(pairs) < 2:
+            return
+        same = (segment[1:] == segment[:-1]) & (pair[1:] == pair[:-1])
+        motion = self.rates[segment[1:], pair[1:]] * (parameter[1:] - parameter[:-1])
+        for r in np.flatnonzero(same & (distance[:-1] + distance[1:] <= motion)).tolist():
+            self.bisect(int(segment[r]), pairs[r], float(parameter[r]), float(parameter[r + 1]))
+            if self.contact is not None or not self.certified:
+                return
+
+    def bisect(self, k: int, pair: int, s0: float, s1: float) -> None:
+        """Certify pair on [s0, s1] of segment k by bisection with exact distances."""
+        self.refined += 1
+        rate = float(self.rates[k, pair])
+        stack = [(s0, s1, self.known[(k + s0, pair)], self.known[(k + s1, pair)], 0)]
+        while stack:
+            a, b, da, db, depth = stack.pop()
+            if da + db > rate * (b - a):
+                continue
+            if depth >= MAX_BISECTION_DEPTH:
+                self.certified = False
+                return
+            s = 0.5 * (a + b)
+            poses = self.verifier.poses(self.path, np.array([k]), np.array([s]))[0]
+            d = self.distance_at(poses, k + s, pair)
+            if d <= 0.0:
+                return
+            stack += [(a, s, da, d, depth + 1), (s, b, d, db, depth + 1)]
+
+    def _waypoint_minimum(self) -> None:
+        """Exact smallest distance over the waypoints, branch and bound on the planner's
+        bounds (every pair whose bound is below the best exact distance is queried)."""
+        verifier, count = self.verifier, len(self.path)
+        if not len(verifier.pairs):
+            return
+        bounds = np.empty((count, len(verifier.pairs)))
+        for n in range(count):
+            state_bounds(self.path[n], verifier.model, verifier.scratch, bounds[n])
+        segment = np.minimum(np.arange(count), count - 2)
+        parameter = (np.arange(count) - segment).astype(float)
+        poses = verifier.poses(self.path, segment, parameter)
+        best = min(self.known.values(), default=np.inf)
+        for flat in np.argsort(bounds, axis=None).tolist():
+            n, pair = divmod(flat, len(verifier.pairs))
+            if bounds[n, pair] >= best:
+                break
+            best = min(best, self.distance_at(poses[n], float(n), pair))
+
+    def minimum(self) -> ClearanceRecord:
+        if not self.known:
+            return ClearanceRecord(float("inf"), "", "", "", float("nan"), -1)
+        (where, pair), clearance = min(self.known.items(), key=lambda item: item[1])
+        link, geometry, other = self.verifier.world.pair_names(pair)
+        sample = int(where) if where == int(where) else -1
+        return ClearanceRecord(clearance, link, geometry, other, where, sample)
+
+
+_VERIFIERS: weakref.WeakKeyDictionary[CollisionWorld, ExactVerifier] = weakref.WeakKeyDictionary()
+
+
+def verifier_of(world: CollisionWorld) -> ExactVerifier:
+    """The world's exact verifier, built on first use and kept with the world."""
+    verifier = _VERIFIERS.get(world)
+    if verifier is None:
+        verifier = _VERIFIERS[world] = ExactVerifier(world)
+    return verifier
+
+
 def verify_path(
     world: CollisionWorld, waypoints: np.ndarray, clearance: float
 ) -> VerificationReport:
@@ -69,72 +257,14 @@ def verify_path(
 
     Args:
         world: Collision world built with ``self_collision=True``.
-        waypoints: Shape (N, nq), in [rad]; the path is the straight joint segments between them
-            (split every :data:`VERIFY_MOTION_STEP` of robot motion before the check).
+        waypoints: Shape (N, nq), in [rad]; the path is the straight joint segments between them.
         clearance: The required clearance the planner guaranteed, in [m] (reported).
 
     Raises:
         PathVerificationError: a contact or an uncertified interval (never expected: the
             planner's checker is conservative).
     """
-    given = np.asarray(waypoints, dtype=float)
-    if len(given) == 1:  # a single configuration: checked as a motion that does not move
-        path, parameter = np.vstack([given, given]), np.array([0.0, 1.0])
-    else:
-        path = densify(world, given, VERIFY_MOTION_STEP)
-        parameter = _segment_parameter(world, given)
-    report = check_trajectory(world, path, parameter)
-    if report.contacts:
-        c = report.contacts[0]
-        raise PathVerificationError(
-            f"{c.link} ({c.geometry}) touches {c.obstacle} at path parameter {c.time:.4f}, "
-            f"penetration {c.penetration_depth * 1e3:.4f} mm"
-        )
-    if not report.certified:
-        raise PathVerificationError("an interval could not be certified (grazing contact)")
-    self_pairs = int(world.pair_is_self.sum())
-    return VerificationReport(
-        collision_free=report.collision_free,
-        min_clearance=report.min_clearance,
-        required_clearance=clearance,
-        self_collision_pairs=self_pairs,
-        obstacle_pairs=world.pair_count - self_pairs,
-        exact_queries=report.exact_queries,
-        refined_intervals=report.refined_intervals,
-    )
-
-
-def _steps(world: CollisionWorld, waypoints: np.ndarray, step: float) -> np.ndarray:
-    """Pieces of each segment so that no point of the robot moves more than ``step`` [m]."""
-    reach = np.stack([p.reach for p in world.links]).max(axis=0)  # (nq,)
-    motion = np.abs(np.diff(waypoints, axis=0)) @ reach
-    pieces: np.ndarray = np.maximum(1, np.ceil(motion / step)).astype(int)
-    return pieces
-
-
-def densify(world: CollisionWorld, waypoints: np.ndarray, step: float) -> np.ndarray:
-    """The path's straight segments split so that no robot point moves more than ``step`` [m].
-
-    waypoints: shape (N, nq), in [rad] -> shape (M, nq), every waypoint kept.
-    """
-    if len(waypoints) < 2:
-        single: np.ndarray = waypoints.copy()
-        return single
-    pieces = [waypoints[:1]]
-    for k, count in enumerate(_steps(world, waypoints, step).tolist()):
-        s = np.arange(1, count + 1)[:, None] / count
-        pieces.append(waypoints[k] + s * (waypoints[k + 1] - waypoints[k]))
-    dense: np.ndarray = np.vstack(pieces)
-    return dense
-
-
-def _segment_parameter(world: CollisionWorld, waypoints: np.ndarray) -> np.ndarray:
-    """The path parameter (waypoint index, fractional in between) of every densified point."""
-    values = [np.zeros(1)]
-    for k, count in enumerate(_steps(world, waypoints, VERIFY_MOTION_STEP).tolist()):
-        values.append(k + np.arange(1, count + 1) / count)
-    parameter: np.ndarray = np.concatenate(values)
-    return parameter
+    return verifier_of(world).verify(np.asarray(waypoints, dtype=float), clearance)
 
 
 def closest_contact(world: CollisionWorld, q: np.ndarray) -> tuple[float, str, str]:

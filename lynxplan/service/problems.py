@@ -5,7 +5,12 @@ from __future__ import annotations
 from typing import Any
 
 import orjson
+from fastapi import FastAPI, Request
+from fastapi.exceptions import RequestValidationError
+from starlette.exceptions import HTTPException as StarletteHTTPException
 from starlette.responses import Response
+
+from lynxplan.exceptions import LynxplanError
 
 PROBLEM_MEDIA_TYPE = "application/problem+json"
 
@@ -66,3 +71,34 @@ def problem_response(
         media_type=PROBLEM_MEDIA_TYPE,
         headers=headers,
     )
+
+
+def error_response(exc: Exception, method: str, path: str) -> Response:
+    """The problem+json answer to any exception raised while serving ``method path`` (one
+    mapping for the FastAPI routes and the fast path): Problem as given, HTTP errors with their
+    status, validation and domain errors 422, anything else 500 without a traceback."""
+    if isinstance(exc, Problem):
+        return problem_response(exc.status, exc.detail, exc.field, path)
+    if isinstance(exc, StarletteHTTPException):
+        detail = exc.detail if isinstance(exc.detail, str) else str(exc.status_code)
+        if exc.status_code == 404:
+            detail = f"no route {method} {path}"
+        return problem_response(exc.status_code, detail, None, path)
+    if isinstance(exc, RequestValidationError):
+        first = exc.errors()[0] if exc.errors() else {"loc": (), "msg": "invalid request"}
+        loc = [str(part) for part in first.get("loc", ())][1:]
+        return problem_response(422, str(first.get("msg", "invalid")), ".".join(loc) or None, path)
+    if isinstance(exc, LynxplanError):
+        field = getattr(exc, "name", None)
+        return problem_response(422, str(exc), field if isinstance(field, str) else None, path)
+    return problem_response(500, f"internal error ({type(exc).__name__})", None, path)
+
+
+def install_error_handlers(app: FastAPI) -> None:
+    """Answer every error of ``app`` as problem+json (never a traceback)."""
+
+    async def on_error(request: Request, exc: Exception) -> Response:
+        return error_response(exc, request.method, request.url.path)
+
+    for kind in (Problem, StarletteHTTPException, RequestValidationError, LynxplanError, Exception):
+        app.add_exception_handler(kind, on_error)

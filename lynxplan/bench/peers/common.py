@@ -58,3 +58,18 @@ def make_validity(urdf: str, obstacles: list[dict[str, Any]]) -> Any:
         return not pin.computeCollisions(model, data, geometry, geometry_data, q, True)
 
     return valid, model
+
+
+def result_row(
+    problem: str, seed: int, solved: bool, times: tuple[float, float, float], path: list[Any]
+) -> dict[str, Any]:
+    """One JSON result row: times are (began, planned, done) perf counters, in [s]."""
+    began, planned, done = times
+    return {
+        "problem": problem,
+        "seed": seed,
+        "solved": solved,
+        "plan_time": planned - began,
+        "simplify_time": done - planned,
+        "path": path,
+    }

@@ -15,7 +15,7 @@ import sys
 import time
 
 import numpy as np
-from common import make_validity
+from common import make_validity, result_row
 
 
 def main() -> None:
@@ -71,16 +71,7 @@ def main() -> None:
                     [geometric.getState(i)[j] for j in range(nq)]
                     for i in range(geometric.getStateCount())
                 ]
-            results.append(
-                {
-                    "problem": problem["name"],
-                    "seed": seed,
-                    "solved": solved,
-                    "plan_time": planned - began,
-                    "simplify_time": done - planned,
-                    "path": path,
-                }
-            )
+            results.append(result_row(problem["name"], seed, solved, (began, planned, done), path))
     with open(sys.argv[1], "w", encoding="utf-8") as out:  # stdout carries the peer's logs
         json.dump(results, out)
 

@@ -14,7 +14,7 @@ import sys
 import time
 
 import numpy as np
-from common import build
+from common import build, result_row
 
 
 def main() -> None:
@@ -43,16 +43,9 @@ def main() -> None:
             if solved and spec["simplify"]:
                 path = shortcut_path(model, geometry, path, max_step_size=spec["resolution"])
             done = time.perf_counter()
-            results.append(
-                {
-                    "problem": problem["name"],
-                    "seed": seed,
-                    "solved": solved,
-                    "plan_time": planned - began,
-                    "simplify_time": done - planned,
-                    "path": [list(map(float, q)) for q in path] if solved else [],
-                }
-            )
+            rows = [list(map(float, q)) for q in path] if solved else []
+            times = (began, planned, done)
+            results.append(result_row(problem["name"], seed, solved, times, rows))
     with open(sys.argv[1], "w", encoding="utf-8") as out:  # stdout carries the peer's logs
         json.dump(results, out)
 

@@ -1,0 +1,72 @@
+"""The numba kernel that checks a stack of 4x4 poses in one pass (finite, translation in range,
+last row ``0 0 0 1``, rotation block orthonormal and proper), compiled on first use."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from lynxplan.constants import RIGIDITY_REPAIR_TOLERANCE
+
+POSE_OK, POSE_NON_FINITE, POSE_FAR, POSE_BOTTOM_ROW = 0, 1, 2, 3
+POSE_NOT_ORTHONORMAL, POSE_REFLECTION = 4, 5
+
+
+_COMPILED: dict[str, Any] = {}
+
+
+def pose_check_kernel(T: np.ndarray, max_length: float, approach_only: bool) -> np.ndarray:
+    """The first bad pose (:func:`_pose_check`), compiled by numba on first use (``import
+    lynxplan.guards`` stays cheap for the CLI)."""
+    kernel = _COMPILED.get("pose_check")
+    if kernel is None:
+        import numba
+
+        kernel = _COMPILED["pose_check"] = numba.njit(cache=True, nogil=True)(_pose_check)
+    result: np.ndarray = kernel(T, max_length, approach_only)
+    return result
+
+
+def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.ndarray:
+    """First bad pose of ``T`` (N, 4, 4): ``[index, code, detail]`` (code 0: all good)."""
+    out = np.zeros(3)
+    for k in range(T.shape[0]):
+        t = T[k]
+        for i in range(4):
+            for j in range(4):
+                if not math.isfinite(t[i, j]):
+                    out[0], out[1] = k, POSE_NON_FINITE
+                    return out
+        for i in range(3):
+            if abs(t[i, 3]) > max_length:
+                out[0], out[1], out[2] = k, POSE_FAR, t[i, 3]
+                return out
+        bottom = max(abs(t[3, 0]), abs(t[3, 1]), abs(t[3, 2]), abs(t[3, 3] - 1.0))
+        if bottom > 1e-9:
+            out[0], out[1], out[2] = k, POSE_BOTTOM_ROW, bottom
+            return out
+        if approach_only:
+            norm2 = t[0, 2] ** 2 + t[1, 2] ** 2 + t[2, 2] ** 2
+            if abs(norm2 - 1.0) > RIGIDITY_REPAIR_TOLERANCE:
+                out[0], out[1], out[2] = k, POSE_NOT_ORTHONORMAL, abs(norm2 - 1.0)
+                return out
+            continue
+        deviation = 0.0
+        for i in range(3):
+            for j in range(3):
+                dot = t[0, i] * t[0, j] + t[1, i] * t[1, j] + t[2, i] * t[2, j]
+                deviation = max(deviation, abs(dot - (1.0 if i == j else 0.0)))
+        if deviation > RIGIDITY_REPAIR_TOLERANCE:
+            out[0], out[1], out[2] = k, POSE_NOT_ORTHONORMAL, deviation
+            return out
+        det = (
+            t[0, 0] * (t[1, 1] * t[2, 2] - t[1, 2] * t[2, 1])
+            - t[0, 1] * (t[1, 0] * t[2, 2] - t[1, 2] * t[2, 0])
+            + t[0, 2] * (t[1, 0] * t[2, 1] - t[1, 1] * t[2, 0])
+        )
+        if det < 0.0:
+            out[0], out[1], out[2] = k, POSE_REFLECTION, det
+            return out
+    return out

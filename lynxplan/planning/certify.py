@@ -1,0 +1,208 @@
+"""Where the exact verification of a path must query distances: a schedule, compiled with numba.
+
+The exact verifier (:mod:`lynxplan.planning.verify`) certifies each straight joint segment
+``q(s) = q_a + s (q_b - q_a)``, ``s`` in [0, 1], pair by pair. With ``L`` the pair's motion
+bound per unit ``s`` (:func:`lynxplan.planning.kernel_model.pair_rates`: no point of the pair's
+geometry moves, relative to the other side, more than ``L |s1 - s0|`` between ``s0`` and
+``s1``), lower bounds ``d0``, ``d1`` of the pair's distance at ``s0`` and ``s1`` prove it apart
+on the whole interval when ``d0 + d1 > L (s1 - s0)`` (proof in :mod:`lynxplan.collision.check`:
+at any ``s`` in between every point is at least ``max(d0 - a, d1 - b)`` away with ``a + b = L
+(s1 - s0)``).
+
+This module only *chooses* the parameters ``s`` at which the verifier asks coal for exact
+distances; it proves nothing itself:
+
+- a pair whose bounding-sphere gaps at both ends already satisfy the inequality needs no exact
+  query on that segment (a primitive lies inside its circumscribed sphere: a plain, independent
+  lower bound);
+- any other pair gets a chain ``0 = s_0 < s_1 < ... < s_n = 1`` such that the planner's tight
+  separating-axis bounds ``b`` satisfy ``b_i + b_i+1 > L (s_i+1 - s_i)``. Exact distances are
+  at least those bounds, so the verifier's exact test of the same inequality passes with few
+  queries (about ``L / 2d`` on a segment that stays ``d`` from an obstacle). Where the bounds
+  give no guidance (a bound <= 0, or steps below :data:`MIN_STEP`) the chain jumps to ``s = 1``
+  and the verifier bisects that interval with exact distances.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba
+import numpy as np
+
+from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
+from lynxplan.planning.validity import centre_gap, joint_poses, pair_bound, primitive_pose
+
+#: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.
+MIN_STEP = 1e-4
+#: First try of a chain step, as a multiple of bound / rate (the two-sided test allows < 2).
+STEP_GROWTH = 1.9
+
+
+@numba.njit(cache=True, inline="always")
+def sphere_gap(p: int, model: Any, scratch: Any) -> float:
+    """Bounding-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
+
+    Robot primitives by their circumscribed spheres; a box obstacle (a cylinder obstacle is
+    stored as its bounding box, which contains it) by its exact point distance, a sphere
+    obstacle exactly.
+    """
+    prim_radius, pairs = model[7], model[8]
+    kinds, poses_b, obstacle_half = model[10], model[12], model[13]
+    poses = scratch[3]
+    a, b = pairs[p, 0], pairs[p, 1]
+    pa = poses[a]
+    if pairs[p, 2] == 1:
+        return centre_gap(pa, prim_radius[a], poses[b], prim_radius[b])
+    pose = poses_b[b]
+    if kinds[b] == OBSTACLE_SPHERE:
+        return centre_gap(pa, prim_radius[a], pose, obstacle_half[b, 0])
+    total = 0.0
+    dx, dy, dz = pa[0, 3] - pose[0, 3], pa[1, 3] - pose[1, 3], pa[2, 3] - pose[2, 3]
+    for k in range(3):
+        excess = abs(pose[0, k] * dx + pose[1, k] * dy + pose[2, k] * dz) - obstacle_half[b, k]
+        if excess > 0.0:
+            total += excess * excess
+    box_gap: float = math.sqrt(total) - prim_radius[a]
+    return box_gap
+
+
+@numba.njit(cache=True, inline="always")
+def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any) -> None:
+    q = scratch[7]
+    for j in range(q_a.shape[0]):
+        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
+    joint_poses(q, model, scratch)
+    for g in range(model[4].shape[0]):
+        primitive_pose(g, model, scratch)
+
+
+@numba.njit(cache=True, inline="always")
+def _bound_at(
+    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any
+) -> float:
+    q = scratch[7]
+    for j in range(q_a.shape[0]):
+        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
+    joint_poses(q, model, scratch)
+    pairs = model[8]
+    primitive_pose(pairs[p, 0], model, scratch)
+    if pairs[p, 2] == 1:
+        primitive_pose(pairs[p, 1], model, scratch)
+    return float(pair_bound(p, model, scratch))
+
+
+@numba.njit(cache=True)
+def segment_rates(path: np.ndarray, model: Any) -> np.ndarray:
+    """Motion bound of every pair per unit s on every segment: (M, nq) -> (M - 1, P), in [m]."""
+    rates = model[9]
+    out = np.zeros((path.shape[0] - 1, rates.shape[0]))
+    for k in range(path.shape[0] - 1):
+        for p in range(rates.shape[0]):
+            total = 0.0
+            for j in range(path.shape[1]):
+                total += rates[p, j] * abs(path[k + 1, j] - path[k, j])
+            out[k, p] = total
+    return out
+
+
+@numba.njit(cache=True)
+def _end_bounds(
+    q_a: np.ndarray, q_b: np.ndarray, end: float, model: Any, scratch: Any, out: np.ndarray
+) -> None:
+    """Sphere gaps out[0] and tight bounds out[1] of every pair at s = end: out (2, P)."""
+    _poses_at(q_a, q_b, end, model, scratch)
+    for p in range(model[8].shape[0]):
+        out[0, p] = sphere_gap(p, model, scratch)
+        out[1, p] = pair_bound(p, model, scratch)
+
+
+@numba.njit(cache=True)
+def _chain(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    p: int,
+    rate: float,
+    ends: tuple[float, float],
+    model: Any,
+    scratch: Any,
+    rows: Any,
+    count: int,
+) -> int:
+    """Append the chain of pair p on one segment to rows (segment column already set by the
+    caller); returns the new row count, -1 when full. ends: the bounds at s = 0 and 1."""
+    parameter, pair = rows[1], rows[2]
+    s, b = 0.0, ends[0]
+    while True:
+        if count >= pair.shape[0]:
+            return -1
+        parameter[count], pair[count] = s, p
+        count += 1
+        if s >= 1.0:
+            return count
+        if b + ends[1] > rate * (1.0 - s) or b <= 0.0:
+            s, b = 1.0, ends[1]
+            continue
+        t = min(1.0, s + STEP_GROWTH * b / rate)
+        bt = _bound_at(q_a, q_b, t, p, model, scratch)
+        while b + bt <= rate * (t - s) and t - s >= MIN_STEP:
+            t = s + 0.5 * (t - s)
+            bt = _bound_at(q_a, q_b, t, p, model, scratch)
+        if t - s < MIN_STEP:
+            t, bt = 1.0, ends[1]
+        s, b = t, bt
+
+
+@numba.njit(cache=True)
+def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
+    """The exact queries that certify a path: rows (segment, s, pair), chains in order.
+
+    path: (M, nq), in [rad]. rows: output columns (segment int64, s float, pair int64), each of
+    shape (capacity,). Returns the number of rows, or -1 when the capacity is too small. A pair
+    whose relative pose does not change on a segment gets one row at s = 0 (unless its sphere
+    gap is positive there).
+    """
+    segment, parameter, pair = rows
+    count_pairs = model[8].shape[0]
+    rates = segment_rates(path, model)
+    start, end = np.empty((2, count_pairs)), np.empty((2, count_pairs))
+    count = 0
+    for k in range(path.shape[0] - 1):
+        _end_bounds(path[k], path[k + 1], 0.0, model, scratch, start)
+        _end_bounds(path[k], path[k + 1], 1.0, model, scratch, end)
+        for p in range(count_pairs):
+            rate = rates[k, p]
+            first = count
+            if rate == 0.0:
+                if start[0, p] > 0.0:
+                    continue
+                if count >= pair.shape[0]:
+                    return -1
+                parameter[count], pair[count] = 0.0, p
+                count += 1
+            elif start[0, p] + end[0, p] > rate:
+                continue
+            else:
+                ends = (start[1, p], end[1, p])
+                count = _chain(path[k], path[k + 1], p, rate, ends, model, scratch, rows, count)
+                if count < 0:
+                    return -1
+            segment[first:count] = k
+    return count
+
+
+@numba.njit(cache=True)
+def configuration_poses(
+    path: np.ndarray,
+    segment: np.ndarray,
+    parameter: np.ndarray,
+    model: Any,
+    scratch: Any,
+    out: np.ndarray,
+) -> None:
+    """Primitive poses at each row's configuration: out (R, G, 4, 4)."""
+    for r in range(segment.shape[0]):
+        k = segment[r]
+        _poses_at(path[k], path[k + 1], parameter[r], model, scratch)
+        out[r] = scratch[3]

@@ -1,0 +1,189 @@
+"""The arrays of the planner's compiled kernels, built once per collision world.
+
+:func:`kernel_model` turns a :class:`lynxplan.collision.CollisionWorld` and a list of pairs into
+one tuple of contiguous arrays (joints, primitives, pairs, pair motion rates, obstacles) that the
+numba kernels of :mod:`lynxplan.planning.validity` and :mod:`lynxplan.planning.certify` read;
+:func:`make_scratch` gives the matching work arrays.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from lynxplan.collision.obstacles import BoxObstacle, CylinderObstacle, SphereObstacle
+from lynxplan.collision.world import CollisionWorld
+
+#: Obstacle kinds of the kernels.
+OBSTACLE_BOX, OBSTACLE_SPHERE = 0, 1
+
+
+def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Kernel arrays of a world for the given pairs (rows ``(a, b, is_self)``, shape (P, 3)).
+
+    Layout: 0 joint axes, 1 joint configuration indices, 2 joint parents, 3 joint placements,
+    4 primitive joints, 5 primitive placements, 6 primitive box half sizes, 7 primitive bounding
+    radii, 8 pairs, 9 pair motion rates (P, nq) [m/rad], 10 obstacle kinds, 11 obstacle centres,
+    12 obstacle poses, 13 obstacle half sizes, 14 obstacle bounding radii.
+    """
+    axes, index_q, parents, placements, prim_joints, prim_placements = world._kernel_joints
+    half = np.array([_box_half_extents(p.kind, p.half_extents) for p in world.links])
+    kinds, centres, rotations, obstacle_half, obstacle_radius = _obstacle_arrays(world)
+    arrays = (
+        axes.astype(np.int64),
+        index_q.astype(np.int64),
+        parents.astype(np.int64),
+        placements,
+        prim_joints.astype(np.int64),
+        prim_placements,
+        half,
+        np.linalg.norm(half, axis=1),
+        pairs.astype(np.int64).reshape(-1, 3),
+        pair_rates(world, pairs),
+        kinds,
+        centres,
+        rotations,
+        obstacle_half,
+        obstacle_radius,
+    )
+    return tuple(np.ascontiguousarray(a) for a in arrays)
+
+
+def world_pairs(world: CollisionWorld) -> np.ndarray:
+    """Every pair of the collision world, in its order: rows ``(a, b, is_self)``, (P, 3)."""
+    rows = np.column_stack((world.pair_link, world.pair_other, world.pair_is_self))
+    return np.asarray(rows, dtype=np.int64).reshape(-1, 3)
+
+
+def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
+    """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
+    counters (edge checks, advancement steps, pair bounds evaluated) and the pair that last
+    failed a quick state test."""
+    joints, prims, pairs, nq = len(model[0]), len(model[4]), len(model[8]), model[9].shape[1]
+    del prims
+    return (
+        np.empty((joints, 4, 4)),
+        np.empty((4, 4)),
+        np.zeros((4, 4)),
+        np.empty((len(model[4]), 4, 4)),
+        np.empty(pairs),
+        np.empty(pairs),
+        np.empty(pairs),
+        np.empty(nq),
+        np.empty((3, 3)),
+        np.zeros(4, dtype=np.int64),
+        np.zeros(len(model[4]), dtype=np.int64),
+    )
+
+
+def _box_half_extents(kind: str, half: np.ndarray) -> np.ndarray:
+    if kind in ("box", "mesh"):  # a mesh primitive is its hull, inside this box
+        return np.array(half, dtype=float)
+    radius, half_length = float(half[0]), float(half[1])
+    return np.array([radius, radius, half_length])
+
+
+def planner_pairs(world: CollisionWorld) -> tuple[np.ndarray, list[tuple[str, str]]]:
+    """Checked pairs: moving primitive vs obstacle, and non-adjacent primitive pairs."""
+    rows, names = [], []
+    links = world.links
+    for o, obstacle in enumerate(world.obstacles):
+        for g, link in enumerate(links):
+            if link.joint != 0:
+                rows.append((g, o, 0))
+                names.append((link.geometry, obstacle.name))
+    parents = list(world.model.parents)
+    for a in range(len(links)):
+        for b in range(a + 1, len(links)):
+            ja, jb = links[a].joint, links[b].joint
+            if ja == jb or parents[ja] == jb or parents[jb] == ja:
+                continue  # same or adjacent bodies: touching by design (URDF adjacency)
+            rows.append((a, b, 1))
+            names.append((links[a].geometry, f"self:{links[b].geometry}"))
+    return np.array(rows, dtype=np.int64).reshape(-1, 3), names
+
+
+def _ancestors(model: Any, joint: int) -> set[int]:
+    """Configuration indices of the joints that move a body on ``joint``."""
+    found = set()
+    while joint > 0:
+        found.add(int(model.joints[joint].idx_q))
+        joint = int(model.parents[joint])
+    return found
+
+
+def _symmetric_about_root_axis(world: CollisionWorld, g: int) -> int | None:
+    """The configuration index of the first joint if fixed primitive g is a cylinder coaxial
+    with it (turning that joint then cannot change any distance to g), else None."""
+    model, link = world.model, world.links[g]
+    if link.joint != 0 or link.kind != "cylinder" or model.njoints < 2 or model.parents[1] != 0:
+        return None
+    axis_index = {"JointModelRX": 0, "JointModelRY": 1, "JointModelRZ": 2}.get(
+        model.joints[1].shortname()
+    )
+    if axis_index is None:
+        return None
+    placement = np.array(model.jointPlacements[1].homogeneous)
+    joint_axis, joint_origin = placement[:3, axis_index], placement[:3, 3]
+    cylinder_axis, centre = link.placement[:3, 2], link.placement[:3, 3]
+    offset = centre - joint_origin
+    off_axis = offset - (offset @ joint_axis) * joint_axis
+    if np.linalg.norm(np.cross(joint_axis, cylinder_axis)) > 1e-12:
+        return None
+    if np.linalg.norm(off_axis) > 1e-12:
+        return None
+    return int(model.joints[1].idx_q)
+
+
+def pair_rates(world: CollisionWorld, pairs: np.ndarray) -> np.ndarray:
+    """Motion of each pair per radian of each joint, shape (P, nq), in [m/rad].
+
+    Obstacle pair: the primitive's reach about each joint. Self pair: the distance between two
+    bodies depends only on their relative pose, so joints that move both (common ancestors)
+    do not count; each other joint counts with the reach of the body it moves. A fixed
+    cylinder coaxial with the first joint (the AL5's base) is symmetric about it: that joint
+    does not count either.
+    """
+    model = world.model
+    rates = np.zeros((len(pairs), model.nq))
+    for p, (a, b, is_self) in enumerate(pairs.tolist()):
+        first = world.links[a]
+        if not is_self:
+            rates[p] = first.reach
+            continue
+        second = world.links[b]
+        only_a = _ancestors(model, first.joint) - _ancestors(model, second.joint)
+        only_b = _ancestors(model, second.joint) - _ancestors(model, first.joint)
+        for j in only_a:
+            rates[p, j] += first.reach[j]
+        for j in only_b:
+            rates[p, j] += second.reach[j]
+        for g in (a, b):
+            symmetric = _symmetric_about_root_axis(world, g)
+            if symmetric is not None:
+                rates[p, symmetric] = 0.0
+    return rates
+
+
+def _obstacle_arrays(world: CollisionWorld) -> tuple[np.ndarray, ...]:
+    count = len(world.obstacles)
+    kinds = np.zeros(count, dtype=np.int64)
+    centres = np.zeros((count, 3))
+    poses = np.zeros((count, 4, 4))
+    half = np.zeros((count, 3))
+    for o, obstacle in enumerate(world.obstacles):
+        centres[o] = obstacle.centre
+        poses[o, :3, :3] = np.asarray(obstacle.rotation)
+        poses[o, :3, 3] = obstacle.centre
+        poses[o, 3, 3] = 1.0
+        if isinstance(obstacle, BoxObstacle):
+            half[o] = obstacle.size / 2.0
+        elif isinstance(obstacle, SphereObstacle):
+            kinds[o] = OBSTACLE_SPHERE
+            half[o] = obstacle.radius
+        elif isinstance(obstacle, CylinderObstacle):
+            half[o] = (obstacle.radius, obstacle.radius, obstacle.length / 2.0)
+    # Bounding-sphere radius of each obstacle (a sphere's own radius).
+    radius = np.where(kinds == OBSTACLE_SPHERE, half[:, 0], np.linalg.norm(half, axis=1))
+    return kinds, centres, poses, half, radius

@@ -1,0 +1,95 @@
+"""Exact path verification (conservative advancement on coal distances) against a dense exact
+check, and against paths that graze an obstacle between their waypoints."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from conftest import dense_min_distance
+
+from lynxplan.arm import Arm
+from lynxplan.collision import BoxObstacle, CollisionWorld, SphereObstacle
+from lynxplan.exceptions import PathVerificationError
+from lynxplan.planning.verify import verifier_of, verify_path
+
+TABLE = BoxObstacle("table", [0.0, 0.1, -0.105], [0.9, 0.7, 0.03])
+POST = BoxObstacle("post", [0.12, 0.18, 0.05], [0.04, 0.04, 0.3])
+#: How deep (or how far) the probe sphere is placed from the moving gripper, in [m].
+GRAZE = 1e-4
+#: Random paths of the comparison and their waypoints.
+RANDOM_PATHS, RANDOM_WAYPOINTS = 16, 3
+
+
+@pytest.fixture(scope="module")
+def world(arm: Arm) -> CollisionWorld:
+    return CollisionWorld(arm, [TABLE, POST], self_collision=True)
+
+
+def _random_path(arm: Arm, rng: np.random.Generator) -> np.ndarray:
+    lower, upper = np.asarray(arm.limits.lower), np.asarray(arm.limits.upper)
+    centre = lower + (upper - lower) * rng.uniform(0.3, 0.7, size=lower.size)
+    steps = rng.normal(scale=0.35, size=(RANDOM_WAYPOINTS, lower.size))
+    return np.clip(centre + np.cumsum(steps, axis=0), lower, upper)
+
+
+def test_verdict_agrees_with_a_dense_exact_check(arm: Arm, world: CollisionWorld) -> None:
+    """A certified path has no contact at >= 10 exact checks per segment and every 0.002 rad;
+    a path the dense check finds in contact is rejected."""
+    rng = np.random.default_rng(14)
+    verdicts = []
+    for _ in range(RANDOM_PATHS):
+        path = _random_path(arm, rng)
+        distance, where = dense_min_distance(world, path)
+        try:
+            report = verify_path(world, path, 0.0)
+        except PathVerificationError:
+            verdicts.append(False)
+            continue
+        verdicts.append(True)
+        assert report.collision_free
+        assert distance > 0.0, (path, where)
+        # The reported minimum is an exact distance at a point of the path.
+        assert report.min_clearance.clearance >= distance - 1e-9
+    assert any(verdicts) and not all(verdicts), verdicts
+
+
+def _graze_world(arm: Arm, q_a: np.ndarray, q_b: np.ndarray, gap: float) -> CollisionWorld:
+    """A small sphere placed ``gap`` [m] from the pen at the middle of the segment (negative:
+    penetrating), far from it at both ends."""
+    middle = 0.5 * (q_a + q_b)
+    tool = arm.fk(middle)
+    centre = tool[:3, 3] + 0.03 * tool[:3, 0]
+    probe = CollisionWorld(arm, [SphereObstacle("probe", centre, 0.005)], self_collision=True)
+    obstacle_pairs = ~probe.pair_is_self
+    distance = probe.distances(middle)[0][obstacle_pairs].min()
+    radius = 0.005 + distance - gap
+    return CollisionWorld(arm, [SphereObstacle("probe", centre, radius)], self_collision=True)
+
+
+@pytest.mark.parametrize("gap", [-GRAZE, GRAZE])
+def test_a_path_grazing_an_obstacle_between_waypoints(arm: Arm, gap: float) -> None:
+    q_a = np.radians([40.0, 40.0, -60.0, 60.0, 0.0])
+    q_b = np.radians([100.0, 40.0, -60.0, 60.0, 0.0])
+    world = _graze_world(arm, q_a, q_b, gap)
+    ends = world.distances(np.vstack([q_a, q_b]))[:, ~world.pair_is_self]
+    assert ends.min() > 0.02  # both waypoints far from the probe
+    path = np.vstack([q_a, q_b])
+    if gap < 0:
+        contact = r"gripper_1\) touches probe at path parameter 0\.[45]"
+        with pytest.raises(PathVerificationError, match=contact):
+            verify_path(world, path, 0.0)
+    else:
+        report = verify_path(world, path, 0.0)
+        assert report.collision_free
+        assert report.min_clearance.obstacle == "probe"
+        assert 0.0 < report.min_clearance.clearance <= gap + 1e-6
+
+
+def test_a_single_configuration_and_the_verifier_is_kept_per_world(
+    arm: Arm, world: CollisionWorld
+) -> None:
+    q = np.radians([90.0, 60.0, -60.0, 60.0, 0.0])
+    report = verify_path(world, q[None, :], 0.0)
+    exact = world.distances(q)[0].min()
+    assert report.min_clearance.clearance == pytest.approx(exact, abs=1e-9)
+    assert verifier_of(world) is verifier_of(world)
