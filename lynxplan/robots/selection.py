@@ -3,6 +3,7 @@ continuous with the previous step along a track."""
 
 from __future__ import annotations
 
+import math
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -33,23 +34,32 @@ def select_one(
     slots = np.flatnonzero(batch.valid[0])
     q = np.array(batch.q[0, slots])  # fresh; each solution's q is a read-only row of it
     q.setflags(write=False)
-    within = batch.within_limits[0, slots]
-    perr = batch.position_error[0, slots]
-    oerr = batch.orientation_error[0, slots].tolist()
     names = batch.branch_names
+    # plain Python on the few branches: cheaper than numpy calls on arrays this small
+    rows = q.tolist()
     solutions = [
         RobotIkSolution(q[i], names[b], w, p, o)
         for i, (b, w, p, o) in enumerate(
-            zip(slots.tolist(), within.tolist(), perr.tolist(), oerr, strict=True)
+            zip(
+                slots.tolist(),
+                batch.within_limits[0, slots].tolist(),
+                batch.position_error[0, slots].tolist(),
+                batch.orientation_error[0, slots].tolist(),
+                strict=True,
+            )
         )
     ]
     if verify:
         verify_branches(robot, solutions)
-    eligible = within & (perr <= batch.distance[0] + REACH_TOLERANCE)
-    best = None
-    if eligible.any():
-        cost = np.where(eligible, ((q - reference) ** 2).sum(axis=1), np.inf)
-        best = int(np.argmin(cost))
+    limit = float(batch.distance[0]) + REACH_TOLERANCE
+    ref = reference.tolist()
+    best, best_cost = None, math.inf
+    for i, s in enumerate(solutions):
+        if not s.within_limits or s.position_error > limit:
+            continue
+        cost = sum((a - r) ** 2 for a, r in zip(rows[i], ref, strict=True))
+        if cost < best_cost:
+            best, best_cost = i, cost
     ranked = (
         best
         if best is not None

@@ -5,7 +5,7 @@ lateral offset and the pitch sum follows from the approach. The roll is a soluti
 approach lies in the arm plane (approach targets) or equals the best roll of the target (full
 poses): the roots of one scalar function f(theta). It is evaluated with one cosine and one sine
 of the roll: the yaw and pitch-sum angles enter only through their cosines and sines, which
-follow from the target by square roots (``roll_equation_reference`` is the same function written
+follow from the target by square roots (``reference_terms`` is the same function written
 with the angles, kept for the degenerate targets and the tests). Lengths [m], angles [rad].
 """
 
@@ -31,28 +31,12 @@ _DEGENERATE = 1e-12
 
 
 @numba.njit(cache=True, nogil=True)
-def roll_equation_reference(problem: RollProblem, theta: float) -> float:
-    """The scalar whose roots are the rolls of an off-axis tool (one side), with angles.
+def reference_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]:
+    """``roll_terms`` written with the angles (yaw, pitch sum, best roll): the degenerate
+    targets, and the reference the tests hold the angle-free form to.
 
-    ``g[:, :3]`` is G = Rt Rt0^T, ``g[:, 3]`` the target approach axis.
+    ``g[:3, :3]`` is G = Rt Rt0^T, ``g[:3, 3]`` the target approach axis.
     """
-    prm, target, g, mode, side, phi_ref, sum_ref = problem
-    d0, d1, d2 = (
-        target[0, 3] - prm[F.C1],
-        target[1, 3] - prm[F.C1 + 1],
-        target[2, 3] - prm[F.C1 + 2],
-    )
-    phi, _ = yaw(prm, d0, d1, d2, theta, side, phi_ref)
-    big_phi, out = pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
-    if mode == MODE_APPROACH:
-        return out
-    # sin, not the wrapped difference: continuous through +-pi; roots at pi are rejected later
-    return math.sin(best_roll(prm, g, phi, big_phi) - theta)
-
-
-@numba.njit(cache=True, nogil=True)
-def _reference_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]:
-    """``roll_terms`` with angles (the degenerate targets)."""
     prm, target, g, mode, side, phi_ref, sum_ref = problem
     d0, d1, d2 = (
         target[0, 3] - prm[F.C1],
@@ -63,6 +47,7 @@ def _reference_terms(problem: RollProblem, theta: float) -> tuple[float, float, 
     big_phi, out = pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
     if mode == MODE_APPROACH:
         return out, 1.0, miss
+    # sin, not the wrapped difference: continuous through +-pi; roots at pi are rejected later
     delta = best_roll(prm, g, phi, big_phi) - theta
     return math.sin(delta), math.cos(delta), miss
 
@@ -122,7 +107,7 @@ def roll_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]
     prm, _, g, mode, side, _, _ = problem
     rho = g[3, 0]
     if rho <= _DEGENERATE:
-        return _reference_terms(problem, theta)
+        return reference_terms(problem, theta)
     ct, st = math.cos(theta), math.sin(theta)
     lat = prm[F.LAM4] + prm[F.W0 + 2] + ct * prm[F.E1 + 2] + st * prm[F.E2 + 2]
     # yaw phi = alpha -+ beta, alpha = atan2(dh, dp), beta = acos(lat / rho) (see ``yaw``)
@@ -143,7 +128,7 @@ def roll_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]
     in_h = cphi * ah - sphi * ap
     norm = math.sqrt(in_h * in_h + ak * ak)
     if norm <= _DEGENERATE:  # approach along the pitch axis: the reference pitch sum
-        return _reference_terms(problem, theta)
+        return reference_terms(problem, theta)
     # pitch sum Phi = atan2(ak, in_h) - gamma0
     cg, sg = g[4, 2], g[4, 3]
     cbig, sbig = (in_h * cg + ak * sg) / norm, (ak * cg - in_h * sg) / norm
