@@ -111,12 +111,13 @@ def check_expectations(
     parsed = parse_expectations(block, type(scenario).metrics, scenario.units)
     results = []
     for item in parsed:
+        note = output.notes.get(item.metric)
         if item.metric not in output.metrics:
             message = f"{item.key}: metric {item.metric!r} was not measured by this run"
+            message += f" ({note})" if note else ""
             results.append(ExpectationResult(item.key, item.text, None, False, message))
         else:
             checked = evaluate(item, output.metrics[item.metric], scenario.units)
-            note = output.notes.get(item.metric)
             if note and not checked.passed:
                 checked = replace(checked, message=f"{checked.message} ({note})")
             results.append(checked)

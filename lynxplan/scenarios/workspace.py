@@ -88,13 +88,7 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
             progress=progress,
         )
     grid = tool_positions(report_grid(arm.limits), arm.geometry) if scenario.report_grid else None
-    metrics = {
-        "volume": estimate.volume_revolution,
-        "volume_voxels": estimate.volume_voxels,
-        "reach": estimate.max_reach,
-        "z_min": estimate.z_range[0],
-        "z_max": estimate.z_range[1],
-    }
+    metrics = {"volume": estimate.volume_revolution, **_sampled_metrics(estimate)}
     summary = (
         f"workspace of {arm.urdf_path.name}: {estimate.samples:,} samples, volume "
         f"{estimate.volume_revolution / scale**3:.4g} {unit}^3 (voxel estimate "
@@ -109,6 +103,16 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
         "report_grid_points": None if grid is None else int(grid.shape[0]),
     }
     return KindOutput(metrics, summary, details, payload=(estimate, grid))
+
+
+def _sampled_metrics(estimate: Any) -> dict[str, Any]:
+    """The metrics every workspace estimate has (SI): voxel volume, reach and height range."""
+    return {
+        "volume_voxels": estimate.volume_voxels,
+        "reach": estimate.max_reach,
+        "z_min": estimate.z_range[0],
+        "z_max": estimate.z_range[1],
+    }
 
 
 def _run_sampled(scenario: Input, robot: Any) -> KindOutput:
@@ -126,12 +130,7 @@ def _run_sampled(scenario: Input, robot: Any) -> KindOutput:
             seed=scenario.seed,
             progress=progress,
         )
-    metrics = {
-        "volume_voxels": estimate.volume_voxels,
-        "reach": estimate.max_reach,
-        "z_min": estimate.z_range[0],
-        "z_max": estimate.z_range[1],
-    }
+    metrics = _sampled_metrics(estimate)
     summary = (
         f"workspace of {robot.name}: {estimate.samples:,} samples, voxel volume "
         f"{estimate.volume_voxels / scale**3:.4g} {unit}^3 ({scenario.voxel_size:g} {unit} "
@@ -155,7 +154,8 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
 
     unit = scenario.units.length
     if not isinstance(output.payload, tuple):  # a URDF robot: the sampled points
-        write_json(out_dir / "workspace.json", {**output.details, "units": {"length": "m"}})
+        units = {"length": "m", "volume": "m^3"}
+        write_json(out_dir / "workspace.json", {**output.details, **output.metrics, "units": units})
         if quick:
             return ["workspace.json"]
         write_html(output.payload.positions, out_dir / "workspace.html", unit)

@@ -213,7 +213,9 @@ def _waypoint(
         pose = _approach_pose(np.array(entry.position) * length, np.array(entry.approach))
         key = "position"
     # The AL5 has the report's branch rule; a URDF robot takes the branch nearest q_reference.
-    report_rule = entry.ik == "report" and not hasattr(arm, "ik_batch")
+    from lynxplan.arm.model import Arm
+
+    report_rule = entry.ik == "report" and isinstance(arm, Arm)
     try:
         result = arm.ik(
             pose,

@@ -159,10 +159,6 @@ class Al5Kinematics:
         return np.asarray(select_continuous(ik.q, ik.within_limits, q_near)[0][0])
 
 
-#: A branch whose position misses the target by more than this is not a solution [m].
-ROBOT_REACH_TOLERANCE = 1e-9
-
-
 class RobotKinematics:
     """A yaw-pitch-pitch-pitch-roll robot of :func:`lynxplan.load_robot`.
 
@@ -204,9 +200,11 @@ class RobotKinematics:
         return math.atan2(float(approach @ turned), -float(approach @ k))
 
     def _follow(self, batch: Any, q_before: np.ndarray, s: np.ndarray) -> PathIk:
+        from lynxplan.robots.selection import REACH_TOLERANCE
+
         ok = (
             batch.valid
-            & (batch.position_error <= ROBOT_REACH_TOLERANCE + batch.distance[:, None])
+            & (batch.position_error <= REACH_TOLERANCE + batch.distance[:, None])
             & batch.reachable[:, None]
         )
         failed = np.flatnonzero(~ok.any(axis=1))

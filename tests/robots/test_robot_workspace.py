@@ -60,3 +60,26 @@ def test_workspace_command_takes_a_robot(tmp_path, capsys) -> None:
         capsys.readouterr()
         assert main(command) == 2
         assert "has no frame 'pen'" in capsys.readouterr().err
+
+
+def test_workspace_scenario_of_a_urdf_robot_reports_what_it_measured(tmp_path) -> None:
+    import json
+
+    from lynxplan.scenarios import run_scenario
+
+    body = {
+        "kind": "workspace",
+        "robot": {"name": "so101"},
+        "units": {"length": "m", "angle": "deg"},
+        "samples": 20_000,
+        "voxel_size": 0.01,
+        "expect": {"min_volume_voxels": 0.001, "min_volume": 0.001},
+    }
+    result = run_scenario(body, tmp_path / "out", quick=True)
+    summary = json.loads((tmp_path / "out" / "workspace.json").read_text())
+    assert summary["volume_voxels"] == pytest.approx(result.metrics["volume_voxels"], rel=1e-12)
+    assert result.expectations[0].passed  # the voxel volume is measured
+    # The planar revolution volume is the AL5's: not measured, and the message says why.
+    assert not result.expectations[1].passed
+    assert "not measured" in result.expectations[1].message
+    assert "use volume_voxels" in result.expectations[1].message
