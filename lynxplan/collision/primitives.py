@@ -68,13 +68,14 @@ def joint_structure(model: Any) -> tuple[list[tuple[int, int]], list[np.ndarray]
     return axes, placements
 
 
-def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray]:
-    """Convex hull of a mesh (coal BVH or Convex) centred on its bounding box, and the offset
-    (4, 4) of that frame in the geometry frame."""
+def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray, np.ndarray]:
+    """Convex hull of a mesh (coal BVH or Convex) centred on its bounding box, the offset (4, 4)
+    of that frame in the geometry frame, and the hull's vertices (K, 3) in it [m]."""
     import coal
 
     if not type(shape).__name__.startswith("Convex"):
-        shape.buildConvexHull(True, "Qt")
+        if shape.convex is None:  # built once per mesh, kept by the robot's GeometryModel
+            shape.buildConvexHull(True, "Qt")
         shape = shape.convex
     points = np.array(shape.points(), dtype=float).reshape(-1, 3)
     if points.shape[0] < 4 or not np.isfinite(points).all():
@@ -85,7 +86,7 @@ def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray]:
     hull = coal.Convex.convexHull(shifted, False, "Qt")
     offset = np.eye(4)
     offset[:3, 3] = centre
-    return hull, offset
+    return hull, offset, points - centre
 
 
 def _cover(kind: str, half: np.ndarray) -> tuple[np.ndarray, float]:
@@ -122,9 +123,8 @@ def link_primitive(
     elif kind == "Cylinder":
         kind, half = "cylinder", np.array([shape.radius, shape.halfLength, 0.0])
     elif kind.startswith(("BVHModel", "Convex")):
-        shape, offset = _mesh_hull(shape, name)
+        shape, offset, points = _mesh_hull(shape, name)
         placement = placement @ offset
-        points = np.array(shape.points(), dtype=float).reshape(-1, 3)
         kind, half = "mesh", np.abs(points).max(axis=0)
     else:
         raise CollisionModelError(name, f"shape {kind} is not supported (box, cylinder, mesh)")
