@@ -12,13 +12,15 @@ at any ``s`` in between every point is at least ``max(d0 - a, d1 - b)`` away wit
 This module only *chooses* the parameters ``s`` at which the verifier asks coal for exact
 distances; it proves nothing itself:
 
-- a pair whose bounding-sphere gaps at both ends already satisfy the inequality needs no exact
-  query on that segment (a primitive lies inside its circumscribed sphere: a plain, independent
-  lower bound);
+- a pair whose bounding-sphere gaps prove it apart on the segment needs no exact query there
+  (a primitive lies inside its circumscribed sphere: a plain, independent lower bound): either
+  the gaps at both ends satisfy the inequality with the static bound ``L``, or a short chain
+  of sphere gaps does with the lever-arm motion bounds of
+  :func:`lynxplan.planning.validity.span_motion` (tested against the real motion);
 - any other pair gets a chain ``0 = s_0 < s_1 < ... < s_n = 1`` such that the planner's tight
   separating-axis bounds ``b`` satisfy ``b_i + b_i+1 > L (s_i+1 - s_i)``. Exact distances are
-  at least those bounds, so the verifier's exact test of the same inequality passes with few
-  queries (about ``L / 2d`` on a segment that stays ``d`` from an obstacle). Where the bounds
+  at least those bounds, so the verifier's exact test of the same inequality (with the motion
+  bound the schedule hands it for each pair of consecutive rows) passes with few queries (about ``L / 2d`` on a segment that stays ``d`` from an obstacle). Where the bounds
   give no guidance (a bound <= 0, or steps below :data:`MIN_STEP`) the chain jumps to ``s = 1``
   and the verifier bisects that interval with exact distances.
 """
@@ -32,12 +34,21 @@ import numba
 import numpy as np
 
 from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
-from lynxplan.planning.validity import centre_gap, joint_poses, pair_bound, primitive_pose
+from lynxplan.planning.validity import (
+    STEP_GROWTH,
+    centre_gap,
+    joint_poses,
+    lever_arms,
+    pair_bound,
+    primitive_pose,
+    reach_step,
+    span_motion,
+)
 
 #: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.
 MIN_STEP = 1e-4
-#: First try of a chain step, as a multiple of bound / rate (the two-sided test allows < 2).
-STEP_GROWTH = 1.9
+#: Longest chain of sphere gaps tried on a segment before the exact chain is scheduled.
+SPHERE_STEPS = 24
 
 
 @numba.njit(cache=True, inline="always")
@@ -80,8 +91,17 @@ def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: A
 
 @numba.njit(cache=True, inline="always")
 def _bound_at(
-    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    s: float,
+    p: int,
+    model: Any,
+    scratch: Any,
+    side: int,
+    sphere: bool,
 ) -> float:
+    """Pair p's bound at q_a + s (q_b - q_a): its sphere gap if ``sphere`` else the tight one;
+    its lever arms -> scratch[13][side]."""
     q = scratch[7]
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
@@ -90,6 +110,9 @@ def _bound_at(
     primitive_pose(pairs[p, 0], model, scratch)
     if pairs[p, 2] == 1:
         primitive_pose(pairs[p, 1], model, scratch)
+    lever_arms(p, scratch[0], scratch[3], model, scratch[13][side])
+    if sphere:
+        return float(sphere_gap(p, model, scratch))
     return float(pair_bound(p, model, scratch))
 
 
@@ -119,11 +142,39 @@ def _end_bounds(
 
 
 @numba.njit(cache=True)
+def _sphere_chain(
+    q_a: np.ndarray, q_b: np.ndarray, p: int, gap: float, model: Any, scratch: Any
+) -> bool:
+    """Whether pair p's sphere gaps alone prove it apart on the whole segment: a chain of at
+    most :data:`SPHERE_STEPS` points whose consecutive gaps exceed the motion bound between
+    them (:func:`lynxplan.planning.validity.span_motion`), one-sided steps where not."""
+    arms = scratch[13]
+    _bound_at(q_a, q_b, 0.0, p, model, scratch, 0, True)
+    s = 0.0
+    for _ in range(SPHERE_STEPS):
+        if gap <= 0.0:
+            return False
+        one = reach_step(gap, p, arms[0], model, scratch)
+        if s + one >= 1.0:
+            return True
+        t = min(1.0, s + STEP_GROWTH * one)
+        gap_t = _bound_at(q_a, q_b, t, p, model, scratch, 1, True)
+        if gap_t > 0.0 and gap + gap_t > span_motion(p, t - s, model, scratch):
+            s, gap = t, gap_t
+        else:
+            s += one
+            gap = _bound_at(q_a, q_b, s, p, model, scratch, 1, True)
+        arms[0, :] = arms[1]
+        if s >= 1.0:
+            return True
+    return False
+
+
+@numba.njit(cache=True)
 def _chain(
     q_a: np.ndarray,
     q_b: np.ndarray,
     p: int,
-    rate: float,
     ends: tuple[float, float],
     model: Any,
     scratch: Any,
@@ -131,44 +182,61 @@ def _chain(
     count: int,
 ) -> int:
     """Append the chain of pair p on one segment to rows (segment column already set by the
-    caller); returns the new row count, -1 when full. ends: the bounds at s = 0 and 1."""
-    parameter, pair = rows[1], rows[2]
+    caller); returns the new row count, -1 when full. ends: the bounds at s = 0 and 1. The
+    motion column holds, for each row but the last of the chain, the bound of the pair's motion
+    until the next row (the verifier's test); a jump to s = 1 gets the static bound."""
+    parameter, pair, motion = rows[1], rows[2], rows[3]
+    arms = scratch[13]
+    static = 0.0
+    for j in range(q_a.shape[0]):
+        static += model[9][p, j] * scratch[14][j]
     s, b = 0.0, ends[0]
+    _bound_at(q_a, q_b, 0.0, p, model, scratch, 0, False)
     while True:
         if count >= pair.shape[0]:
             return -1
-        parameter[count], pair[count] = s, p
+        parameter[count], pair[count], motion[count] = s, p, -1.0
         count += 1
         if s >= 1.0:
             return count
-        if b + ends[1] > rate * (1.0 - s) or b <= 0.0:
+        if b <= 0.0:
+            motion[count - 1] = static * (1.0 - s)
             s, b = 1.0, ends[1]
             continue
-        t = min(1.0, s + STEP_GROWTH * b / rate)
-        bt = _bound_at(q_a, q_b, t, p, model, scratch)
-        while b + bt <= rate * (t - s) and t - s >= MIN_STEP:
+        t = min(1.0, s + STEP_GROWTH * reach_step(b, p, arms[0], model, scratch))
+        bt = _bound_at(q_a, q_b, t, p, model, scratch, 1, False)
+        span = span_motion(p, t - s, model, scratch)
+        while b + bt <= span and t - s >= MIN_STEP:
             t = s + 0.5 * (t - s)
-            bt = _bound_at(q_a, q_b, t, p, model, scratch)
+            bt = _bound_at(q_a, q_b, t, p, model, scratch, 1, False)
+            span = span_motion(p, t - s, model, scratch)
         if t - s < MIN_STEP:
-            t, bt = 1.0, ends[1]
+            motion[count - 1] = static * (1.0 - s)
+            s, b = 1.0, ends[1]
+            continue
+        motion[count - 1] = span
         s, b = t, bt
+        arms[0, :] = arms[1]
 
 
 @numba.njit(cache=True)
 def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
-    """The exact queries that certify a path: rows (segment, s, pair), chains in order.
+    """The exact queries that certify a path: rows (segment, s, pair, motion), chains in order.
 
-    path: (M, nq), in [rad]. rows: output columns (segment int64, s float, pair int64), each of
-    shape (capacity,). Returns the number of rows, or -1 when the capacity is too small. A pair
-    whose relative pose does not change on a segment gets one row at s = 0 (unless its sphere
-    gap is positive there).
+    path: (M, nq), in [rad]. rows: output columns (segment int64, s float, pair int64, motion
+    float [m]: the bound of the pair's motion until the next row of the chain, -1 on a chain's
+    last row), each of shape (capacity,). Returns the number of rows, or -1 when the capacity
+    is too small. A pair whose relative pose does not change on a segment gets one row at
+    s = 0 (unless its sphere gap is positive there).
     """
-    segment, parameter, pair = rows
+    segment, parameter, pair, motion = rows
     count_pairs = model[8].shape[0]
     rates = segment_rates(path, model)
     start, end = np.empty((2, count_pairs)), np.empty((2, count_pairs))
     count = 0
     for k in range(path.shape[0] - 1):
+        for j in range(path.shape[1]):
+            scratch[14][j] = abs(path[k + 1, j] - path[k, j])
         _end_bounds(path[k], path[k + 1], 0.0, model, scratch, start)
         _end_bounds(path[k], path[k + 1], 1.0, model, scratch, end)
         for p in range(count_pairs):
@@ -179,13 +247,15 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
                     continue
                 if count >= pair.shape[0]:
                     return -1
-                parameter[count], pair[count] = 0.0, p
+                parameter[count], pair[count], motion[count] = 0.0, p, -1.0
                 count += 1
-            elif start[0, p] + end[0, p] > rate:
-                continue
+            elif start[0, p] + end[0, p] > rate or _sphere_chain(
+                path[k], path[k + 1], p, start[0, p], model, scratch
+            ):
+                continue  # the sphere gaps prove it apart: no exact query
             else:
                 ends = (start[1, p], end[1, p])
-                count = _chain(path[k], path[k + 1], p, rate, ends, model, scratch, rows, count)
+                count = _chain(path[k], path[k + 1], p, ends, model, scratch, rows, count)
                 if count < 0:
                     return -1
             segment[first:count] = k

@@ -25,7 +25,9 @@ def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, 
     Layout: 0 joint axes, 1 joint configuration indices, 2 joint parents, 3 joint placements,
     4 primitive joints, 5 primitive placements, 6 primitive box half sizes, 7 primitive bounding
     radii, 8 pairs, 9 pair motion rates (P, nq) [m/rad], 10 obstacle kinds, 11 obstacle centres,
-    12 obstacle poses, 13 obstacle half sizes, 14 obstacle bounding radii.
+    12 obstacle poses, 13 obstacle half sizes, 14 obstacle bounding radii, 15 pair joint owners
+    (P, nq): the primitive of the pair that joint j moves relative to the other side (-1: none),
+    16 the joint (frame) index of each configuration index (nq,).
     """
     axes, index_q, parents, placements, prim_joints, prim_placements = world._kernel_joints
     half = np.array([_box_half_extents(p.kind, p.half_extents) for p in world.links])
@@ -46,6 +48,8 @@ def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, 
         rotations,
         obstacle_half,
         obstacle_radius,
+        pair_owners(world, pairs),
+        _joint_of_coordinate(world),
     )
     return tuple(np.ascontiguousarray(a) for a in arrays)
 
@@ -59,7 +63,8 @@ def world_pairs(world: CollisionWorld) -> np.ndarray:
 def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
     """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
     counters (edge checks, advancement steps, pair bounds evaluated) and the pair that last
-    failed a quick state test."""
+    failed a quick state test, the joint and primitive poses at an edge's start, the joints'
+    lever arms at two points of an edge and the joint steps of an edge."""
     joints, prims, pairs, nq = len(model[0]), len(model[4]), len(model[8]), model[9].shape[1]
     del prims
     return (
@@ -74,6 +79,12 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         np.empty((3, 3)),
         np.zeros(4, dtype=np.int64),
         np.zeros(len(model[4]), dtype=np.int64),
+        np.empty((joints, 4, 4)),
+        np.empty((len(model[4]), 4, 4)),
+        np.empty((2, nq)),
+        np.empty(nq),
+        np.empty((pairs, nq)),
+        np.empty(pairs),
     )
 
 
@@ -164,6 +175,35 @@ def pair_rates(world: CollisionWorld, pairs: np.ndarray) -> np.ndarray:
             if symmetric is not None:
                 rates[p, symmetric] = 0.0
     return rates
+
+
+def pair_owners(world: CollisionWorld, pairs: np.ndarray) -> np.ndarray:
+    """Which primitive of each pair each joint moves relative to the other side, (P, nq).
+
+    Obstacle pair ``(a, o)``: ``a`` for every joint that moves it. Self pair ``(a, b)``: ``a``
+    for the joints that move ``a`` and not ``b``, ``b`` for the converse, -1 for the common
+    ancestors (they move both rigidly) and for joints that move neither.
+    """
+    model = world.model
+    owners = np.full((len(pairs), model.nq), -1, dtype=np.int64)
+    for p, (a, b, is_self) in enumerate(pairs.tolist()):
+        moves_a = _ancestors(model, world.links[a].joint)
+        moves_b = _ancestors(model, world.links[b].joint) if is_self else set()
+        for j in moves_a - moves_b:
+            owners[p, j] = a
+        for j in moves_b - moves_a:
+            owners[p, j] = b
+    return owners
+
+
+def _joint_of_coordinate(world: CollisionWorld) -> np.ndarray:
+    """The joint (frame) index of each configuration index, (nq,) (-1: none)."""
+    model = world.model
+    joints = np.full(model.nq, -1, dtype=np.int64)
+    for j in range(1, model.njoints):
+        if model.joints[j].nq == 1:
+            joints[model.joints[j].idx_q] = j
+    return joints
 
 
 def _obstacle_arrays(world: CollisionWorld) -> tuple[np.ndarray, ...]:

@@ -31,7 +31,12 @@ import numpy as np
 
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.validity import ValidityChecker, edge_fraction, point_is_clear
+from lynxplan.planning.validity import (
+    ValidityChecker,
+    edge_fraction,
+    edge_is_free,
+    point_is_clear,
+)
 
 #: Kernel status codes.
 RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2
@@ -154,7 +159,7 @@ def rrt_connect_kernel(
         for j in range(nq):
             new[j] = nodes[a, near, j] + fraction * (sample[j] - nodes[a, near, j])
         if not point_is_clear(nodes[a, near], new, 1.0, model, scratch, clearance) or (
-            edge_fraction(nodes[a, near], new, model, scratch, clearance) < 1.0
+            not edge_is_free(nodes[a, near], new, model, scratch, clearance)
         ):
             meta[0] = b
             continue

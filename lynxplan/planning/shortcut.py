@@ -22,7 +22,7 @@ import numba
 import numpy as np
 
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.validity import ValidityChecker, edge_fraction, point_is_clear
+from lynxplan.planning.validity import ValidityChecker, edge_is_free, point_is_clear
 
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
@@ -95,7 +95,7 @@ def shortcut_kernel(
         if i1 == i2:
             continue
         if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
-            edge_fraction(first, second, model, scratch, clearance) < 1.0
+            not edge_is_free(first, second, model, scratch, clearance)
         ):
             continue
         idle = 0
@@ -118,7 +118,7 @@ def shortcut_kernel(
         count = size
     k = 1
     while k < count - 1:
-        if edge_fraction(path[k - 1], path[k + 1], model, scratch, clearance) >= 1.0:
+        if edge_is_free(path[k - 1], path[k + 1], model, scratch, clearance):
             for m in range(k, count - 1):
                 path[m] = path[m + 1]
             count -= 1

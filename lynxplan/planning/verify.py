@@ -115,16 +115,18 @@ class ExactVerifier:
         configuration_poses(path, segment, parameter, self.model, self.scratch, out)
         return out
 
-    def schedule(self, path: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """The rows (segment, s, pair) to query exactly (:func:`certify.schedule`)."""
+    def schedule(self, path: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The rows (segment, s, pair, motion to the next row) to query exactly
+        (:func:`certify.schedule`)."""
         capacity = _ROWS
         while True:
             segment = np.empty(capacity, dtype=np.int64)
             parameter = np.empty(capacity)
             pair = np.empty(capacity, dtype=np.int64)
-            rows = schedule(path, self.model, self.scratch, (segment, parameter, pair))
+            motion = np.empty(capacity)
+            rows = schedule(path, self.model, self.scratch, (segment, parameter, pair, motion))
             if rows >= 0:
-                return segment[:rows], parameter[:rows], pair[:rows]
+                return segment[:rows], parameter[:rows], pair[:rows], motion[:rows]
             capacity *= 4
 
     def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
@@ -175,7 +177,7 @@ class _PathCheck:
         return self.known[key]
 
     def run(self) -> None:
-        segment, parameter, pair = self.verifier.schedule(self.path)
+        segment, parameter, pair, motion = self.verifier.schedule(self.path)
         poses = self.verifier.poses(self.path, segment, parameter)
         where = (segment + parameter).tolist()
         pairs = pair.tolist()
@@ -185,9 +187,9 @@ class _PathCheck:
         self._waypoint_minimum()
         if self.contact is not None or len(pairs) < 2:
             return
-        same = (segment[1:] == segment[:-1]) & (pair[1:] == pair[:-1])
-        motion = self.rates[segment[1:], pair[1:]] * (parameter[1:] - parameter[:-1])
-        for r in np.flatnonzero(same & (distance[:-1] + distance[1:] <= motion)).tolist():
+        # Consecutive rows of one chain (same segment and pair, a motion bound between them).
+        same = (segment[1:] == segment[:-1]) & (pair[1:] == pair[:-1]) & (motion[:-1] >= 0.0)
+        for r in np.flatnonzero(same & (distance[:-1] + distance[1:] <= motion[:-1])).tolist():
             self.bisect(int(segment[r]), pairs[r], float(parameter[r]), float(parameter[r + 1]))
             if self.contact is not None or not self.certified:
                 return
