@@ -18,10 +18,11 @@ distances; it proves nothing itself:
   of sphere gaps does with the lever-arm motion bounds of
   :func:`lynxplan.planning.validity.span_motion` (tested against the real motion);
 - any other pair gets a chain ``0 = s_0 < s_1 < ... < s_n = 1`` such that the planner's tight
-  separating-axis bounds ``b`` satisfy ``b_i + b_i+1 > L (s_i+1 - s_i)``. Exact distances are
-  at least those bounds, so the verifier's exact test of the same inequality (with the motion
-  bound the schedule hands it for each pair of consecutive rows) passes with few queries (about ``L / 2d`` on a segment that stays ``d`` from an obstacle). Where the bounds
-  give no guidance (a bound <= 0, or steps below :data:`MIN_STEP`) the chain jumps to ``s = 1``
+  separating-axis bounds ``b`` satisfy ``b_i + b_i+1 > L (s_i+1 - s_i)``. Exact distances are at
+  least those bounds, so the verifier's exact test of the same inequality (with the motion bound
+  the schedule hands it for each pair of consecutive rows) passes with few queries (about ``L /
+  2d`` on a segment that stays ``d`` from an obstacle). Where the bounds give no guidance (a
+  bound <= 0, or steps below :data:`MIN_STEP`) the chain jumps to ``s = 1``
   and the verifier bisects that interval with exact distances.
 """
 
@@ -41,6 +42,7 @@ from lynxplan.planning.validity import (
     lever_arms,
     pair_bound,
     primitive_pose,
+    primitive_poses,
     reach_step,
     span_motion,
 )
@@ -149,7 +151,12 @@ def _sphere_chain(
     most :data:`SPHERE_STEPS` points whose consecutive gaps exceed the motion bound between
     them (:func:`lynxplan.planning.validity.span_motion`), one-sided steps where not."""
     arms = scratch[13]
+    if gap <= 0.0:
+        return False
     _bound_at(q_a, q_b, 0.0, p, model, scratch, 0, True)
+    gap_end = _bound_at(q_a, q_b, 1.0, p, model, scratch, 1, True)
+    if gap_end > 0.0 and gap + gap_end > span_motion(p, 1.0, model, scratch):
+        return True  # one two-sided interval: the whole segment
     s = 0.0
     for _ in range(SPHERE_STEPS):
         if gap <= 0.0:
@@ -276,3 +283,16 @@ def configuration_poses(
         k = segment[r]
         _poses_at(path[k], path[k + 1], parameter[r], model, scratch)
         out[r] = scratch[3]
+
+
+@numba.njit(cache=True)
+def waypoint_bounds(
+    path: np.ndarray, model: Any, scratch: Any, bounds: np.ndarray, poses: np.ndarray
+) -> None:
+    """Tight bounds of every pair (N, P), in [m], and primitive poses (N, G, 4, 4) at every
+    waypoint of path (N, nq), in one call."""
+    for n in range(path.shape[0]):
+        primitive_poses(path[n], model, scratch)
+        poses[n] = scratch[3]
+        for p in range(model[8].shape[0]):
+            bounds[n, p] = pair_bound(p, model, scratch)

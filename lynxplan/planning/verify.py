@@ -35,9 +35,13 @@ import numpy as np
 
 from lynxplan.collision import ClearanceRecord, CollisionWorld
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
-from lynxplan.planning.certify import configuration_poses, schedule, segment_rates
+from lynxplan.planning.certify import (
+    configuration_poses,
+    schedule,
+    segment_rates,
+    waypoint_bounds,
+)
 from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pairs
-from lynxplan.planning.validity import state_bounds
 
 #: Bisection levels of one interval before it is reported as not certified (grazing contact).
 MAX_BISECTION_DEPTH = 40
@@ -158,11 +162,18 @@ class _PathCheck:
 
     def __init__(self, verifier: ExactVerifier, path: np.ndarray) -> None:
         self.verifier, self.path = verifier, path
-        self.rates = segment_rates(path, verifier.model)  # (M - 1, P)
+        self._rates: np.ndarray | None = None  # (M - 1, P), for bisection only
         self.known: dict[tuple[float, int], float] = {}
         self.contact: str | None = None
         self.certified = True
         self.refined = 0
+
+    @property
+    def rates(self) -> np.ndarray:
+        """Static motion bound of every pair per unit s on every segment, (M - 1, P), in [m]."""
+        if self._rates is None:
+            self._rates = segment_rates(self.path, self.verifier.model)
+        return self._rates
 
     def distance_at(self, poses: np.ndarray, where: float, pair: int) -> float:
         key = (where, pair)
@@ -220,11 +231,8 @@ class _PathCheck:
         if not len(verifier.pairs):
             return
         bounds = np.empty((count, len(verifier.pairs)))
-        for n in range(count):
-            state_bounds(self.path[n], verifier.model, verifier.scratch, bounds[n])
-        segment = np.minimum(np.arange(count), count - 2)
-        parameter = (np.arange(count) - segment).astype(float)
-        poses = verifier.poses(self.path, segment, parameter)
+        poses = np.empty((count, len(verifier.world.links), 4, 4))
+        waypoint_bounds(self.path, verifier.model, verifier.scratch, bounds, poses)
         best = min(self.known.values(), default=np.inf)
         for flat in np.argsort(bounds, axis=None).tolist():
             n, pair = divmod(flat, len(verifier.pairs))
