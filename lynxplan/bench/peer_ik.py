@@ -67,9 +67,9 @@ def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list
     # IK needs no geometry, and placo cannot resolve package:// mesh URIs: drop the shapes
     with open(urdf) as handle:
         text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
-    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as handle:
-        handle.write(text)
-    robot = placo.RobotWrapper(handle.name, placo.Flags.ignore_collisions)
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as stripped:
+        stripped.write(text)
+    robot = placo.RobotWrapper(stripped.name, placo.Flags.ignore_collisions)
     solver = placo.KinematicsSolver(robot)
     solver.mask_fbase(True)
     task = solver.add_frame_task(tool, np.eye(4))
