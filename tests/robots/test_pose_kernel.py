@@ -100,3 +100,23 @@ def test_out_of_reach_pose_falls_back_to_the_nearest() -> None:
     batch = robot.ik_batch(pose[None])
     assert not batch.reachable[0]
     assert batch.distance[0] == pytest.approx(one.distance, abs=1e-12)
+
+
+def test_poses_next_to_a_fold_of_the_elbow_round_trip() -> None:
+    """The SO-101's elbow folds near q3 = -1.28849 rad (its built-in link angles): there the
+    two elbow branches are ~1e-5 rad apart on the exact chain and Newton converges linearly.
+    The start configuration must still come back to 1e-7 rad (found by the 1e6 round trips)."""
+    robot = load_robot("so101")
+    base = np.array([-0.5369933, 0.83660157, -1.28849203, 0.46747002, 1.75448164])
+    starts = [base]
+    for shift in (-1e-3, -1e-4, -1e-5, 1e-5, 1e-4, 1e-3):
+        q = base.copy()
+        q[2] += shift
+        q[3] -= shift  # keep the pitch sum
+        starts.append(q)
+    q0 = np.array(starts)
+    batch = robot.ik_batch(robot.fk(q0))
+    assert batch.reachable.all()
+    gap = np.where(batch.valid[..., None], np.abs(batch.q - q0[:, None, :]), np.inf)
+    assert gap.max(axis=2).min(axis=1).max() < 1e-7
+    assert np.where(batch.valid, batch.position_error, 0.0).max() <= 1e-12

@@ -40,11 +40,13 @@ AXIAL_APPROACH = 1e-6
 #: A closed-form branch that misses the reach by more than this [m] is not polished.
 REACH_MISS = 1e-5
 #: Gauss-Newton iterations of the polish at most, and the pose error at which it stops.
-NEWTON_STEPS = 8
+NEWTON_STEPS = 60
 NEWTON_TOLERANCE = 1e-15
-#: From a closed-form start the error falls quadratically (1e-6, 1e-12, ...): a polish still
-#: above this after SLOW_STEPS iterations is not converging to an exact branch and stops.
-SLOW_STEPS, SLOW_ERROR = 3, 1e-9
+#: An iteration must divide the error by at least this much, or the polish stops: from a
+#: closed-form start it falls quadratically (1e-6, 1e-12, ...), next to a fold of the elbow
+#: (a double root: the error ~ the square of the joint gap, which Newton halves) by ~4 per
+#: step; a start that is not near an exact branch falls slower and stops early.
+MIN_FALL = 2.0
 
 
 @numba.njit(cache=True, nogil=True)
@@ -62,7 +64,8 @@ def polish_pose(
     """Gauss-Newton on the pose error of the exact chain, from a closed-form branch of the
     nearly identical ideal model (~1e-6 away): position error [m] and the rotation vector
     vee(R Rt^T - Rt R^T) / 2 [rad] against the geometric Jacobian (6, 5). The target is reachable
-    exactly (zero residual), so it converges quadratically; stops when the error stops falling.
+    exactly (zero residual), so it converges quadratically (linearly next to a fold of the
+    elbow); stops when the error stops falling by MIN_FALL.
 
     Scratch: pose, work (4, 4); jac (6, 5); origins (5, 6); normal (7, 5): J^T J, its LU row
     order, and J^T e.
@@ -70,7 +73,7 @@ def polish_pose(
     previous = math.inf
     e = np.empty(6)
     step = np.empty(5)
-    for iteration in range(NEWTON_STEPS):
+    for _ in range(NEWTON_STEPS):
         chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
         for i in range(3):
             e[i] = pose[i, 3] - target[i, 3]
@@ -87,9 +90,7 @@ def polish_pose(
         size = 0.0
         for i in range(6):
             size = max(size, abs(e[i]))
-        if size < NEWTON_TOLERANCE or not size < previous:
-            return
-        if iteration >= SLOW_STEPS and size > SLOW_ERROR:
+        if size < NEWTON_TOLERANCE or not size * MIN_FALL <= previous:
             return
         previous = size
         for i in range(5):
