@@ -120,3 +120,22 @@ def test_poses_next_to_a_fold_of_the_elbow_round_trip() -> None:
     gap = np.where(batch.valid[..., None], np.abs(batch.q - q0[:, None, :]), np.inf)
     assert gap.max(axis=2).min(axis=1).max() < 1e-7
     assert np.where(batch.valid, batch.position_error, 0.0).max() <= 1e-12
+
+
+def test_al5_single_pose_path_matches_the_batch() -> None:
+    """Robot('al5').ik goes through Arm.ik; the same branches and selection as the batch."""
+    from lynxplan.robots.selection import select_one
+
+    robot = load_robot("al5")
+    poses = robot.fk(robot.random_configurations(100, seed=8))
+    far = poses[0].copy()
+    far[:3, 3] *= 5.0  # out of reach: the general path's nearest solution
+    for pose in [*poses, far]:
+        one = robot.ik(pose)
+        batch = robot.ik_batch(pose[None])
+        other = select_one(robot, batch, robot._default_reference[0], verify=False)
+        assert one.selected == other.selected and one.reachable == other.reachable
+        np.testing.assert_allclose(
+            [s.q for s in one.solutions], [s.q for s in other.solutions], atol=0
+        )
+        assert one.distance == pytest.approx(other.distance, abs=1e-15)

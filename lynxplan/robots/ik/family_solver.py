@@ -1,4 +1,5 @@
-"""Python side of the yaw-pitch-pitch-pitch-roll solver: packing, AL5 delegation, results."""
+"""Python side of the yaw-pitch-pitch-pitch-roll solver: kernel calls, the near-axis rescue,
+the single-pose path, results (the AL5 delegation: ``al5_bridge``)."""
 
 from __future__ import annotations
 
@@ -9,6 +10,7 @@ import numpy as np
 
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
+from lynxplan.robots.ik.al5_bridge import al5_fill
 from lynxplan.robots.results import RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
@@ -60,7 +62,7 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         within.fill(False)
         perr.fill(np.nan)
         oerr.fill(np.nan)
-        rest = ~_al5_fill(robot, target, reference, q, valid, within, perr, oerr)
+        rest = ~al5_fill(robot, target, reference, q, valid, within, perr, oerr)
     elif target.kind == fk_.MODE_POSE:
         rest = ~_pose_fill(robot, target, reference, q, valid, within, perr, oerr)
     if rest is None or rest.all():
@@ -278,48 +280,3 @@ def _pose_fill(
     )
     solved &= np.isnan(target.roll)
     return solved
-
-
-def _al5_fill(
-    robot: Robot,
-    target: Target,
-    reference: np.ndarray,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    perr: np.ndarray,
-    oerr: np.ndarray,
-) -> np.ndarray:
-    """Targets the AL5 kernels of lynxplan.arm solve (same numbers as before); returns which."""
-    from lynxplan.arm.ik import IkStatus
-
-    ref = np.broadcast_to(reference, (target.poses.shape[0], 5)).copy()
-    given = ~np.isnan(target.roll)
-    ref[given, 4] = target.roll[given]
-    arm = robot._arm
-    batch = arm.ik_batch(
-        target.poses, q_reference=ref, approach_only=target.kind == fk_.MODE_APPROACH
-    )
-    ok: np.ndarray = np.asarray(np.asarray(batch.status) == IkStatus.OK)
-    if not ok.any():
-        return ok
-    valid[ok] = True
-    q_arm = np.asarray(batch.q)[ok]
-    poses = np.asarray(arm.fk(q_arm.reshape(-1, 5))).reshape(-1, 4, 4, 4)
-    goal = target.poses[ok]
-    q[ok] = q_arm
-    within[ok] = np.asarray(batch.within_limits)[ok]
-    perr[ok] = np.linalg.norm(poses[:, :, :3, 3] - goal[:, None, :3, 3], axis=2)
-    if target.kind == fk_.MODE_APPROACH:
-        cosine = np.einsum("nbi,ni->nb", poses[:, :, :3, 2], goal[:, :3, 2])
-        sine = np.linalg.norm(np.cross(poses[:, :, :3, 2], goal[:, None, :3, 2]), axis=2)
-        oerr[ok] = np.arctan2(sine, cosine)
-    else:
-        m = np.einsum("nji,nbjk->nbik", goal[:, :3, :3], poses[:, :, :3, :3])
-        trace = np.trace(m, axis1=2, axis2=3)
-        vee = np.stack(
-            (m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]),
-            axis=-1,
-        )
-        oerr[ok] = np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), 0.5 * (trace - 1.0))
-    return ok
