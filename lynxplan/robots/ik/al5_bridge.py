@@ -13,6 +13,7 @@ import numba
 import numpy as np
 
 from lynxplan.robots.ik.family_geometry import MODE_APPROACH
+from lynxplan.robots.ik.family_polish import axis_angle, rotation_angle
 
 if TYPE_CHECKING:
     from lynxplan.robots.results import RobotIkResult
@@ -40,26 +41,11 @@ def branch_errors(
             d2 = pose[2, 3] - goal[2, 3]
             position_error[n, b] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             if approach_only:
-                a0, a1, a2 = pose[0, 2], pose[1, 2], pose[2, 2]
-                g0, g1, g2 = goal[0, 2], goal[1, 2], goal[2, 2]
-                c0, c1, c2 = a1 * g2 - a2 * g1, a2 * g0 - a0 * g2, a0 * g1 - a1 * g0
-                sine = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-                orientation_error[n, b] = math.atan2(sine, a0 * g0 + a1 * g1 + a2 * g2)
-                continue
-            # m = goal^T pose (m_ik = sum_r goal_ri pose_rk): its trace and its skew part's vee
-            trace = m01 = m10 = m02 = m20 = m12 = m21 = 0.0
-            for r in range(3):
-                trace += goal[r, 0] * pose[r, 0] + goal[r, 1] * pose[r, 1] + goal[r, 2] * pose[r, 2]
-                m01 += goal[r, 0] * pose[r, 1]
-                m10 += goal[r, 1] * pose[r, 0]
-                m02 += goal[r, 0] * pose[r, 2]
-                m20 += goal[r, 2] * pose[r, 0]
-                m12 += goal[r, 1] * pose[r, 2]
-                m21 += goal[r, 2] * pose[r, 1]
-            v0, v1, v2 = m21 - m12, m02 - m20, m10 - m01
-            orientation_error[n, b] = math.atan2(
-                0.5 * math.sqrt(v0 * v0 + v1 * v1 + v2 * v2), 0.5 * (trace - 1.0)
-            )
+                orientation_error[n, b] = axis_angle(
+                    pose[0, 2], pose[1, 2], pose[2, 2], goal[0, 2], goal[1, 2], goal[2, 2]
+                )
+            else:
+                orientation_error[n, b] = rotation_angle(goal, pose)
 
 
 def al5_fill(
