@@ -14,6 +14,7 @@ import pytest
 
 from lynxplan.robots import Robot, load_robot
 from lynxplan.robots.ik import family_solver
+from lynxplan.robots.results import BranchSlots
 from lynxplan.robots.targets import make_target
 from tests.robots.urdf_factory import write_random_family_urdfs
 
@@ -28,13 +29,10 @@ def _general(robot: Robot, poses: np.ndarray) -> list[np.ndarray]:
     assert robot.family is not None
     if robot.family.tool_on_roll_axis:
         slots = 4
-    q = np.empty((n, slots, 5))
-    valid = np.empty((n, slots), dtype=bool)
-    within = np.empty((n, slots), dtype=bool)
-    perr, oerr = np.empty((n, slots)), np.empty((n, slots))
-    reference = robot._default_reference
-    family_solver._kernel(robot, target, reference, q, valid, within, perr, oerr)
-    family_solver.rescue_near_axis(robot, target, q, valid, within, perr, oerr)
+    out = BranchSlots.empty(n, slots)
+    family_solver._kernel(robot, target, robot._default_reference, out)
+    family_solver.rescue_near_axis(robot, target, out)
+    q, valid, _, perr, oerr = out
     exact = valid & (perr <= EXACT) & (oerr <= EXACT)
     return [q[i][exact[i]] for i in range(n)]
 

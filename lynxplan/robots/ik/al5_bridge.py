@@ -16,7 +16,7 @@ from lynxplan.robots.ik.family_geometry import MODE_APPROACH
 from lynxplan.robots.ik.family_polish import axis_angle, rotation_angle
 
 if TYPE_CHECKING:
-    from lynxplan.robots.results import RobotIkResult
+    from lynxplan.robots.results import BranchSlots, RobotIkResult
     from lynxplan.robots.robot import Robot
     from lynxplan.robots.targets import Target
 
@@ -48,16 +48,7 @@ def branch_errors(
                 orientation_error[n, b] = rotation_angle(goal, pose)
 
 
-def al5_fill(
-    robot: Robot,
-    target: Target,
-    reference: np.ndarray,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    perr: np.ndarray,
-    oerr: np.ndarray,
-) -> np.ndarray:
+def al5_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> np.ndarray:
     """Targets the AL5 kernels of lynxplan.arm solve, into the batch arrays (N, 4, ...);
     returns which (the others need the general kernel)."""
     from lynxplan.arm.ik import IkStatus
@@ -71,6 +62,7 @@ def al5_fill(
     ok: np.ndarray = np.asarray(np.asarray(batch.status) == IkStatus.OK)
     if not ok.any():
         return ok
+    q, valid, within, perr, oerr = out
     valid[ok] = True
     q_arm = np.asarray(batch.q)[ok]
     reached = np.asarray(arm.fk(q_arm.reshape(-1, 5))).reshape(-1, 4, 4, 4)
