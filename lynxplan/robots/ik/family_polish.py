@@ -79,6 +79,21 @@ def lu_solve(lu: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
         x[i] = total / lu[i, i]
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def reached_approach(prm: np.ndarray, pose: np.ndarray) -> tuple[float, float, float]:
+    """The approach axis of a reached pose (4, 4), in the base frame: R (Rt0^T r)."""
+    rt = prm[F.RT0 : F.RT0 + 9]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2  # the approach in the tool frame: Rt0^T r
+    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
+    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
+    return (
+        pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2,
+        pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2,
+        pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2,
+    )
+
+
 @numba.njit(cache=True, nogil=True)
 def conditions(
     problem: ChainProblem,
@@ -95,15 +110,7 @@ def conditions(
     for i in range(3):
         e[i] = pose[i, 3] - target[i, 3]
     # approach axis and pitch axis of the reached configuration
-    rt = prm[F.RT0 : F.RT0 + 9]
-    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
-    # approach in the tool frame: Rt0^T r
-    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
-    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
-    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
-    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
-    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
-    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+    a0, a1, a2 = reached_approach(prm, pose)
     cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
     k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
     pp0, pp1, pp2 = rotate(k0, k1, k2, cy, sy, prm[F.P], prm[F.P + 1], prm[F.P + 2])
@@ -288,14 +295,7 @@ def branch_orientation_error(
     """Angle between target and reached orientation (pose) or approach axes (approach, pitch)."""
     if mode == MODE_POSE:
         return rotation_angle(target, pose)
-    rt = prm[F.RT0 : F.RT0 + 9]
-    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
-    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
-    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
-    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
-    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
-    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
-    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+    a0, a1, a2 = reached_approach(prm, pose)
     if mode == MODE_PITCH:
         k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
         cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
