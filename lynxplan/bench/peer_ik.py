@@ -57,13 +57,58 @@ def run_pink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
     return ok, times
 
 
+def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
+    """placo's KinematicsSolver (QP, soft frame task, joint limits), iterated to convergence."""
+    import re
+    import tempfile
+
+    import placo
+
+    # IK needs no geometry, and placo cannot resolve package:// mesh URIs: drop the shapes
+    with open(urdf) as handle:
+        text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as stripped:
+        stripped.write(text)
+    robot = placo.RobotWrapper(stripped.name, placo.Flags.ignore_collisions)
+    solver = placo.KinematicsSolver(robot)
+    solver.mask_fbase(True)
+    task = solver.add_frame_task(tool, np.eye(4))
+    task.configure(tool, "soft", 1.0, 1.0)
+    ok, times = [], []
+    for target in poses:
+        for name in robot.joint_names():
+            robot.set_joint(name, 0.0)
+        robot.update_kinematics()
+        task.T_world_frame = target
+        start = time.perf_counter()
+        for _ in range(200):
+            solver.solve(True)
+            robot.update_kinematics()
+            if _ok(robot.get_T_world_frame(tool), target):
+                break
+        times.append(time.perf_counter() - start)
+        ok.append(_ok(robot.get_T_world_frame(tool), target))
+    return ok, times
+
+
+def _root_link(urdf: str) -> str:
+    """The URDF's root link: the one link that is no joint's child."""
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(urdf).getroot()
+    children = {c.get("link") for c in tree.iter("child")}
+    roots = [link.get("name") for link in tree.iter("link") if link.get("name") not in children]
+    return str(roots[0]) if roots else "base_link"
+
+
 def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     from ikpy.chain import Chain
 
-    chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=["base_link"])
+    base = [_root_link(urdf)]
+    chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=base)
     names = [link.name for link in chain.links]
     mask = [link.joint_type != "fixed" for link in chain.links]
-    chain = Chain.from_urdf_file(urdf, base_elements=["base_link"], active_links_mask=mask)
+    chain = Chain.from_urdf_file(urdf, base_elements=base, active_links_mask=mask)
     ok, times = [], []
     for target in poses:
         start = time.perf_counter()
@@ -81,9 +126,9 @@ def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
 def main() -> None:
     peer, urdf, tool, poses_path, out = sys.argv[1:6]
     poses = np.load(poses_path)
-    runner = {"pink": run_pink, "ikpy": run_ikpy}[peer]
+    runner = {"pink": run_pink, "ikpy": run_ikpy, "placo": run_placo}[peer]
     ok, times = runner(urdf, tool, poses)
-    package = {"pink": "pin-pink", "ikpy": "ikpy"}[peer]
+    package = {"pink": "pin-pink", "ikpy": "ikpy", "placo": "placo"}[peer]
     with open(out, "w") as handle:
         json.dump(
             {

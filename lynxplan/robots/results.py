@@ -7,26 +7,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lynxplan.arm.ik_result import selected_q
+from lynxplan.arm.ik_result import IkSolution, selected_q
 
-
-class RobotIkSolution(NamedTuple):
-    """One IK branch, verified by forward kinematics on the exact model.
-
-    Attributes:
-        q: Joint angles, shape (n,), in [rad] (read-only).
-        branch: Branch name, e.g. ``"front/elbow-up"`` or ``"back/elbow-down/roll-1"``.
-        within_limits: Whether q is within the joint limits (after snapping).
-        position_error: ``|p_fk(q) - p_target|``, in [m] (the miss when unreachable).
-        orientation_error: Angle to the target orientation (full pose) or between the target
-            and reached approach axes (approach, pitch targets), in [rad].
-    """
-
-    q: np.ndarray
-    branch: str
-    within_limits: bool
-    position_error: float
-    orientation_error: float
+#: One IK branch of any robot, verified by FK on the exact model: the AL5's branch type (one
+#: type for both; its ``q`` has shape (n,) here).
+RobotIkSolution = IkSolution
 
 
 @dataclass(frozen=True)
@@ -59,6 +44,50 @@ class RobotIkResult:
             NoSolutionWithinLimitsError: if no branch is within the joint limits.
         """
         return selected_q(self.solutions, self.selected)
+
+
+class BranchSlots(NamedTuple):
+    """The arrays the IK kernels write for N targets and B branch slots (internal; the batch
+    result is made of them): empty slots NaN / False."""
+
+    q: np.ndarray
+    """(N, B, n) [rad]."""
+    valid: np.ndarray
+    """(N, B) bool."""
+    within: np.ndarray
+    """(N, B) bool."""
+    position_error: np.ndarray
+    """(N, B) [m]."""
+    orientation_error: np.ndarray
+    """(N, B) [rad]."""
+
+    @classmethod
+    def empty(cls, n: int, slots: int, nq: int = 5) -> BranchSlots:
+        """Uninitialised arrays (the kernels write every slot of the targets they solve)."""
+        return cls(
+            np.empty((n, slots, nq)),
+            np.empty((n, slots), dtype=np.bool_),
+            np.empty((n, slots), dtype=np.bool_),
+            np.empty((n, slots)),
+            np.empty((n, slots)),
+        )
+
+    def clear(self) -> None:
+        """Every slot empty."""
+        self.q.fill(np.nan)
+        self.valid.fill(False)
+        self.within.fill(False)
+        self.position_error.fill(np.nan)
+        self.orientation_error.fill(np.nan)
+
+    def rows(self, mask: np.ndarray) -> BranchSlots:
+        """A copy of the targets in ``mask`` (N,) bool."""
+        return BranchSlots(*(np.ascontiguousarray(a[mask]) for a in self))
+
+    def put(self, mask: np.ndarray, part: BranchSlots) -> None:
+        """Write ``part`` (from :meth:`rows`) back to the targets in ``mask``."""
+        for whole, piece in zip(self, part, strict=True):
+            whole[mask] = piece
 
 
 class RobotIkBatch(NamedTuple):
