@@ -1,13 +1,16 @@
 """Path shortcutting and smoothing, compiled with numba; every change is re-validated.
 
-Two passes over a piecewise-linear joint path, both with the planner's validity checker:
+Three passes over a piecewise-linear joint path, all with the planner's validity checker:
 
-1. *Partial shortcutting* (Geraerts & Overmars 2007): pick two random points of the path by arc
+1. *Greedy vertex shortcuts*: from the start, each kept waypoint is joined to the farthest
+   later waypoint it sees directly (one quick midpoint test, then the certified edge), so the
+   random cuts start from a path with few corners.
+2. *Partial shortcutting* (Geraerts & Overmars 2007): pick two random points of the path by arc
    length (anywhere on its segments, not only at waypoints); if the straight edge between them
    is certified free (conservative advancement), it replaces the part of the path between them.
    Cutting between interior points rounds corners off progressively, so this pass also smooths
    the path towards the taut one; each accepted cut shortens the path (triangle inequality).
-2. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
+3. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
 
 The parts of the old path kept around a cut are pieces of certified edges, and the cut itself is
 certified before it is accepted: the path stays valid after every change ("verify after every
@@ -27,7 +30,7 @@ from lynxplan.planning.validity import ValidityChecker, edge_is_free, point_is_c
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
 #: Random cuts stop after this many attempts in a row that changed nothing.
-DEFAULT_SHORTCUT_PATIENCE = 20
+DEFAULT_SHORTCUT_PATIENCE = 10
 #: Points closer than this in joint space are merged, in [rad].
 _MERGE_DISTANCE = 1e-9
 
@@ -57,6 +60,27 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
 
 
 @numba.njit(cache=True)
+def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: float) -> int:
+    """Vertex shortcuts, farthest first: from each kept waypoint, the farthest later waypoint
+    it sees directly becomes the next one (in place on path[:count]); returns the new count."""
+    kept = 0
+    i = 0
+    while i < count - 1:
+        j = count - 1
+        while j > i + 1:
+            if point_is_clear(path[i], path[j], 0.5, model, scratch, clearance) and edge_is_free(
+                path[i], path[j], model, scratch, clearance
+            ):
+                break
+            j -= 1
+        kept += 1
+        path[kept] = path[j]
+        i = j
+    # path[0..kept] now holds the kept waypoints (later ones were copied down in order).
+    return kept + 1
+
+
+@numba.njit(cache=True)
 def shortcut_kernel(
     path: np.ndarray,
     count: int,
@@ -67,8 +91,10 @@ def shortcut_kernel(
     clearance: float,
     work: np.ndarray,
     patience: int,
+    greedy: bool,
 ) -> int:
-    """Partial shortcuts then vertex pruning, in place on path[:count]; returns the new count.
+    """Greedy vertex shortcuts (if ``greedy``), partial shortcuts then vertex pruning, in place on
+    path[:count]; returns the new count.
 
     path: (capacity, nq) with capacity >= count + 2 * iterations; work: same shape. The cuts stop
     early after ``patience`` attempts in a row that changed nothing.
@@ -77,6 +103,8 @@ def shortcut_kernel(
     cumulative = np.empty(path.shape[0])
     first = np.empty(nq)
     second = np.empty(nq)
+    if greedy:
+        count = _greedy(path, count, model, scratch, clearance)
     idle = 0
     for _ in range(iterations):
         if count < 3 or idle >= patience:
@@ -151,6 +179,7 @@ def shortcut(
     seed: int,
     iterations: int = DEFAULT_SHORTCUT_ITERATIONS,
     patience: int = DEFAULT_SHORTCUT_PATIENCE,
+    greedy: bool = True,
 ) -> np.ndarray:
     """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path.
 
@@ -174,6 +203,7 @@ def shortcut(
         checker.clearance,
         work,
         patience,
+        greedy,
     )
     result: np.ndarray = buffer[:count].copy()
     return result
