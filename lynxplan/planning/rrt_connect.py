@@ -13,6 +13,9 @@ gives one root per collision-free IK branch). Each iteration, in the compiled ke
    joins the trees;
 4. swap the trees.
 
+A node's pair slacks (bound minus clearance, the start of every edge walk from it) are computed
+once, when the node is added by an extension (its state test gives them) or on first use.
+
 The planner knows nothing about the robot: only the joint box, the kernel arrays of the checker
 and a random state (:mod:`lynxplan.planning.rng`). The caller runs the kernel in chunks of
 iterations and checks its time limit between chunks; the state lives in arrays, so the result
@@ -33,9 +36,12 @@ from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.validity import (
     ValidityChecker,
-    edge_fraction,
+    edge_fraction_from,
     edge_is_free,
+    pair_bound,
     point_is_clear,
+    primitive_poses,
+    state_slacks,
 )
 
 #: Kernel status codes.
@@ -108,6 +114,48 @@ def _add(
     return int(index)
 
 
+@numba.njit(cache=True, inline="always")
+def _sample(
+    lower: np.ndarray,
+    upper: np.ndarray,
+    goal_bias: float,
+    other: np.ndarray,
+    roots: int,
+    state: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """A uniform sample in the joint box, or (with probability goal_bias) a root of the other
+    tree (other: its nodes, roots: its root count) -> out (nq,)."""
+    if _rng.uniform(state) < goal_bias:
+        out[:] = other[_rng.integer(state, roots)]
+    else:
+        for j in range(out.shape[0]):
+            out[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
+
+
+@numba.njit(cache=True)
+def _slacks(
+    nodes: np.ndarray,
+    slacks: np.ndarray,
+    known: np.ndarray,
+    tree: int,
+    index: int,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> np.ndarray:
+    """The pairs' slacks at a tree node (P,), computed on first use (known: slacks[tree, index]
+    is valid once the flag is set; a node's slacks never change)."""
+    if known[tree, index] == 0:
+        out = slacks[tree, index]
+        primitive_poses(nodes[tree, index], model, scratch)
+        for p in range(out.shape[0]):
+            out[p] = pair_bound(p, model, scratch) - clearance
+        known[tree, index] = 1
+    result: np.ndarray = slacks[tree, index]
+    return result
+
+
 @numba.njit(cache=True)
 def rrt_connect_kernel(
     lower: np.ndarray,
@@ -124,10 +172,13 @@ def rrt_connect_kernel(
     state: np.ndarray,
     meta: np.ndarray,
     iterations: int,
+    slacks: np.ndarray,
+    known: np.ndarray,
 ) -> int:
     """Run up to ``iterations`` RRT-Connect iterations; returns RUNNING, SOLVED or NODE_LIMIT.
 
     nodes: (2, M, nq); parents: (2, M); counts: (2,) nodes per tree; roots: (2,) root counts;
+    slacks: (2, M, P) the pairs' slacks at each node once known (known: (2, M), 1 when);
     state: random state (1,) uint64; meta: [active tree, joint node tree 0, joint node tree 1,
     iterations done] (int64).
     """
@@ -135,18 +186,14 @@ def rrt_connect_kernel(
     capacity = nodes.shape[1]
     sample = np.empty(nq)
     new = np.empty(nq)
+    fresh = np.empty(slacks.shape[2])
     for _ in range(iterations):
         a = meta[0]
         b = 1 - a
         meta[3] += 1
         if counts[0] + 2 >= capacity or counts[1] + 2 >= capacity:
             return NODE_LIMIT
-        if _rng.uniform(state) < goal_bias:
-            pick = _rng.integer(state, roots[b])
-            sample[:] = nodes[b, pick]
-        else:
-            for j in range(nq):
-                sample[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
+        _sample(lower, upper, goal_bias, nodes[b], roots[b], state, sample)
         near = _nearest(nodes[a], counts[a], sample)
         distance = 0.0
         for j in range(nq):
@@ -158,12 +205,16 @@ def rrt_connect_kernel(
         fraction = min(1.0, step / distance)
         for j in range(nq):
             new[j] = nodes[a, near, j] + fraction * (sample[j] - nodes[a, near, j])
-        if not point_is_clear(nodes[a, near], new, 1.0, model, scratch, clearance) or (
-            not edge_is_free(nodes[a, near], new, model, scratch, clearance)
-        ):
+        if not state_slacks(new, model, scratch, clearance, fresh):
+            meta[0] = b
+            continue
+        start = _slacks(nodes, slacks, known, a, near, model, scratch, clearance)
+        if edge_fraction_from(nodes[a, near], new, start, model, scratch, clearance) < 1.0:
             meta[0] = b
             continue
         added = _add(nodes, parents, counts, a, new, near)
+        slacks[a, added, :] = fresh
+        known[a, added] = 1
         # Connect tree b to the new node as far as the straight edge is certified.
         other = _nearest(nodes[b], counts[b], new)
         base = nodes[b, other].copy()
@@ -171,7 +222,8 @@ def rrt_connect_kernel(
         for j in range(nq):
             length += (new[j] - base[j]) ** 2
         length = math.sqrt(length)
-        reached = edge_fraction(base, new, model, scratch, clearance)
+        start = _slacks(nodes, slacks, known, b, other, model, scratch, clearance)
+        reached = edge_fraction_from(base, new, start, model, scratch, clearance)
         parent = other
         pieces = max(1, math.ceil(length / step))
         for k in range(1, pieces + 1):
@@ -248,6 +300,9 @@ def rrt_connect(
     roots = counts.copy()
     state = _rng.seed_state(seed)
     meta = np.array([0, -1, -1, 0], dtype=np.int64)
+    # Pair slacks per node, filled on first use (np.empty: untouched pages cost nothing).
+    slacks = np.empty((2, capacity, len(checker.pair_names)))
+    known = np.zeros((2, capacity), dtype=np.int8)
     model, scratch, clearance = checker.model, checker.scratch, checker.clearance
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
@@ -269,6 +324,8 @@ def rrt_connect(
             state,
             meta,
             CHUNK_ITERATIONS,
+            slacks,
+            known,
         )
         elapsed = time.perf_counter() - began
         if status == SOLVED:

@@ -392,10 +392,94 @@ MAX_GROWTH = 4.0
 
 
 @numba.njit(cache=True)
+def state_slacks(
+    q: np.ndarray, model: Any, scratch: Any, clearance: float, out: np.ndarray
+) -> bool:
+    """Every pair's bound minus the clearance at q (nq,) -> out (P,), in [m]; whether all exceed
+    :data:`STALL_DISTANCE`. Stops at the first pair that does not (out is then partial), trying
+    first the pair that failed last (scratch[9][3])."""
+    primitive_poses(q, model, scratch)
+    count, last = model[8].shape[0], scratch[9][3]
+    if last < count:
+        out[last] = pair_bound(last, model, scratch) - clearance
+        if out[last] <= STALL_DISTANCE:
+            return False
+    for p in range(count):
+        if p != last:
+            out[p] = pair_bound(p, model, scratch) - clearance
+            if out[p] <= STALL_DISTANCE:
+                scratch[9][3] = p
+                return False
+    return True
+
+
+@numba.njit(cache=True)
 def edge_fraction(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1].
+
+    Returns -1 if q_a itself is not valid (:func:`edge_walk`).
+    """
+    return edge_walk(q_a, q_b, model, scratch, clearance, False)
+
+
+@numba.njit(cache=True)
+def edge_fraction_from(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    slack_a: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> float:
+    """:func:`edge_fraction` with the pairs' slacks at q_a already known (slack_a (P,), in [m],
+    from :func:`state_slacks` at exactly q_a): a tree node's, computed once."""
+    scratch[4][:] = slack_a
+    return edge_walk(q_a, q_b, model, scratch, clearance, True)
+
+
+@numba.njit(cache=True, inline="always")
+def _walk_start(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float, known: bool
+) -> bool:
+    """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and first
+    one-sided reach; False when a pair is within :data:`STALL_DISTANCE` at q_a."""
+    pairs, rates = model[8], model[9]
+    count = pairs.shape[0]
+    dq, counters, slack = scratch[14], scratch[9], scratch[4]
+    reach, where, all_arms, trend = scratch[5], scratch[6], scratch[15], scratch[16]
+    for j in range(q_a.shape[0]):
+        dq[j] = abs(q_b[j] - q_a[j])
+    counters[0] += 1
+    counters[1] += 1
+    counters[2] += count
+    primitive_poses(q_a, model, scratch)
+    for p in range(count):
+        if not known:
+            slack[p] = pair_bound(p, model, scratch) - clearance
+        if slack[p] <= STALL_DISTANCE:
+            counters[3] = p
+            return False
+        where[p] = 0.0
+        trend[p] = 0.0
+        static = 0.0
+        for j in range(dq.shape[0]):
+            static += rates[p, j] * dq[j]
+        if slack[p] >= static:  # certified to s = 1 by the static bound alone
+            reach[p] = np.inf
+            continue
+        lever_arms(p, scratch[0], scratch[3], model, all_arms[p])
+        reach[p] = reach_step(slack[p], p, all_arms[p], model, scratch)
+    return True
+
+
+@numba.njit(cache=True)
+def edge_walk(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float, known: bool
+) -> float:
+    """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
+    ``known``, scratch[4] holds the pairs' slacks at q_a.
 
     Every pair keeps the last point s_p of the edge where its bound was evaluated, its slack
     sigma_p above the clearance there, and the point it is certified to. The pair certified
@@ -407,32 +491,12 @@ def edge_fraction(
     (returned), or when every pair is certified to s = 1. Returns -1 if q_a itself is not
     valid. Proof: module docstring.
     """
-    pairs, rates = model[8], model[9]
-    count = pairs.shape[0]
-    dq, counters, slack = scratch[14], scratch[9], scratch[4]
+    count = model[8].shape[0]
+    counters, slack = scratch[9], scratch[4]
     reach, where, arms, all_arms = scratch[5], scratch[6], scratch[13], scratch[15]
     trend = scratch[16]
-    for j in range(q_a.shape[0]):
-        dq[j] = abs(q_b[j] - q_a[j])
-    counters[0] += 1
-    counters[1] += 1
-    counters[2] += count
-    primitive_poses(q_a, model, scratch)
-    for p in range(count):
-        slack[p] = pair_bound(p, model, scratch) - clearance
-        if slack[p] <= STALL_DISTANCE:
-            counters[3] = p
-            return -1.0
-        where[p] = 0.0
-        trend[p] = 0.0
-        static = 0.0
-        for j in range(dq.shape[0]):
-            static += rates[p, j] * dq[j]
-        if slack[p] >= static:  # certified to s = 1 by the static bound alone
-            reach[p] = np.inf
-            continue
-        lever_arms(p, scratch[0], scratch[3], model, all_arms[p])
-        reach[p] = reach_step(slack[p], p, all_arms[p], model, scratch)
+    if not _walk_start(q_a, q_b, model, scratch, clearance, known):
+        return -1.0
     while True:
         p, nearest = 0, np.inf
         for k in range(count):
