@@ -292,8 +292,11 @@ def rrt_connect(
     began = time.perf_counter()
     nq = lower.size
     capacity = settings.max_nodes + 1
-    nodes = np.zeros((2, capacity, nq))
-    parents = np.full((2, capacity), -1, dtype=np.int64)
+    # np.empty: only the first counts[tree] rows of a tree are ever read (roots have parent -1).
+    nodes = np.empty((2, capacity, nq))
+    parents = np.empty((2, capacity), dtype=np.int64)
+    parents[0, 0] = -1
+    parents[1, : len(goals)] = -1
     counts = np.array([1, len(goals)], dtype=np.int64)
     nodes[0, 0] = start
     nodes[1, : len(goals)] = goals

@@ -158,18 +158,36 @@ def shortcut_kernel(
 def merge_collinear(path: np.ndarray) -> np.ndarray:
     """The path without waypoints that lie on the straight line of their neighbours (RRT-Connect
     adds one every step along a connection): the same straight segments, fewer waypoints."""
-    keep = [0]
-    for k in range(1, len(path) - 1):
-        before, after = path[k] - path[keep[-1]], path[k + 1] - path[k]
-        norm_before, norm_after = np.linalg.norm(before), np.linalg.norm(after)
-        if norm_before > 0 and norm_after > 0:
-            gap = np.linalg.norm(before / norm_before - after / norm_after)
-            if gap <= 1e-12:
-                continue
-        keep.append(k)
-    keep.append(len(path) - 1)
-    merged: np.ndarray = path[keep]
+    keep = np.empty(len(path), dtype=np.int64)
+    merged: np.ndarray = path[keep[: _collinear_kernel(path, keep)]]
     return merged
+
+
+@numba.njit(cache=True)
+def _collinear_kernel(path: np.ndarray, keep: np.ndarray) -> int:
+    """Indices of the waypoints to keep -> keep[:count]; returns count."""
+    count = 1
+    keep[0] = 0
+    nq = path.shape[1]
+    for k in range(1, path.shape[0] - 1):
+        last = keep[count - 1]
+        norm_before = norm_after = 0.0
+        for j in range(nq):
+            norm_before += (path[k, j] - path[last, j]) ** 2
+            norm_after += (path[k + 1, j] - path[k, j]) ** 2
+        norm_before, norm_after = np.sqrt(norm_before), np.sqrt(norm_after)
+        if norm_before > 0 and norm_after > 0:
+            gap = 0.0
+            for j in range(nq):
+                before = (path[k, j] - path[last, j]) / norm_before
+                after = (path[k + 1, j] - path[k, j]) / norm_after
+                gap += (before - after) ** 2
+            if np.sqrt(gap) <= 1e-12:
+                continue
+        keep[count] = k
+        count += 1
+    keep[count] = path.shape[0] - 1
+    return count + 1
 
 
 def shortcut(

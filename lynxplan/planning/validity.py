@@ -127,7 +127,14 @@ _compose = _multiply  # out = a @ b for 4x4 rigid transforms (the collision kern
 
 @numba.njit(cache=True, inline="always")
 def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
-    """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4).
+    """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4)."""
+    joint_poses_upto(q, model, scratch, model[3].shape[0] - 1)
+
+
+@numba.njit(cache=True, inline="always")
+def joint_poses_upto(q: np.ndarray, model: Any, scratch: Any, last: int) -> None:
+    """World poses of joint frames 0..last at one configuration q (nq,) -> scratch[0] (a
+    parent's index is below its child's, so those need no other joint).
 
     The joint rotation is applied to the placement's columns directly (a rotation about one
     axis mixes two columns), then composed with the parent's pose.
@@ -137,7 +144,7 @@ def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
     for i in range(4):
         for j in range(4):
             world[0, i, j] = 1.0 if i == j else 0.0
-    for j in range(1, joint_placements.shape[0]):
+    for j in range(1, last + 1):
         angle = q[index_q[j]]
         c, s = math.cos(angle), math.sin(angle)
         a = axes[j]
@@ -372,10 +379,13 @@ def _pair_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
 ) -> float:
     """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
-    q, pairs = scratch[7], model[8]
+    q, pairs, joint_of = scratch[7], model[8], model[4]
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-    joint_poses(q, model, scratch)
+    last = joint_of[pairs[p, 0]]
+    if pairs[p, 2] == 1:
+        last = max(last, joint_of[pairs[p, 1]])
+    joint_poses_upto(q, model, scratch, last)
     primitive_pose(pairs[p, 0], model, scratch)
     if pairs[p, 2] == 1:
         primitive_pose(pairs[p, 1], model, scratch)
