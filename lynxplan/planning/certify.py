@@ -14,9 +14,10 @@ distances; it proves nothing itself:
 
 - a pair whose bounding-sphere gaps prove it apart on the segment needs no exact query there
   (a primitive lies inside its circumscribed sphere: a plain, independent lower bound): either
-  the gaps at both ends satisfy the inequality with the static bound ``L``, or a short chain
-  of sphere gaps does with the lever-arm motion bounds of
-  :func:`lynxplan.planning.validity.span_motion` (tested against the real motion);
+  the gaps at both ends satisfy the inequality with the static bound ``L``, or the gaps on a
+  uniform grid of the segment (all pairs at once) or a short chain of sphere gaps do with the
+  lever-arm motion bounds of :func:`lynxplan.planning.validity.span_motion` (tested against
+  the real motion);
 - any other pair gets a chain ``0 = s_0 < s_1 < ... < s_n = 1`` such that the planner's tight
   separating-axis bounds ``b`` satisfy ``b_i + b_i+1 > L (s_i+1 - s_i)``. Exact distances are at
   least those bounds, so the verifier's exact test of the same inequality (with the motion bound
@@ -51,6 +52,11 @@ from lynxplan.planning.validity import (
 MIN_STEP = 1e-4
 #: Longest chain of sphere gaps tried on a segment before the exact chain is scheduled.
 SPHERE_STEPS = 24
+#: Intervals of the uniform grid of sphere gaps tried first, all pairs at once.
+SPHERE_GRID = 8
+#: ... tried only when the tight bounds at both ends exceed this, in [m] (closer pairs need the
+#: exact chain anyway: a sphere gap is below the tight bound).
+SPHERE_CHAIN_ABOVE = 0.01
 
 
 @numba.njit(cache=True, inline="always")
@@ -178,6 +184,47 @@ def _sphere_chain(
 
 
 @numba.njit(cache=True)
+def _sphere_grid(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    todo: np.ndarray,
+    model: Any,
+    scratch: Any,
+    gaps: np.ndarray,
+    arms: np.ndarray,
+) -> None:
+    """Sphere gaps on a uniform grid of the segment, all pairs at once (one pose computation per
+    grid point): pairs flagged in todo (P,) that the grid proves apart on every interval
+    (:func:`lynxplan.planning.validity.span_motion` between consecutive points) are cleared.
+
+    gaps: (n + 1, P) and arms: (n + 1, P, nq) work arrays; n = gaps.shape[0] - 1.
+    """
+    intervals = gaps.shape[0] - 1
+    for i in range(intervals + 1):
+        _poses_at(q_a, q_b, i / intervals, model, scratch)
+        for p in range(todo.shape[0]):
+            if todo[p]:
+                gaps[i, p] = sphere_gap(p, model, scratch)
+                lever_arms(p, scratch[0], scratch[3], model, arms[i, p])
+    side = scratch[13]
+    for p in range(todo.shape[0]):
+        if not todo[p]:
+            continue
+        proven = True
+        for i in range(intervals):
+            if gaps[i, p] <= 0.0 or gaps[i + 1, p] <= 0.0:
+                proven = False
+                break
+            side[0, :] = arms[i, p]
+            side[1, :] = arms[i + 1, p]
+            if gaps[i, p] + gaps[i + 1, p] <= span_motion(p, 1.0 / intervals, model, scratch):
+                proven = False
+                break
+        if proven:
+            todo[p] = False
+
+
+@numba.njit(cache=True)
 def _chain(
     q_a: np.ndarray,
     q_b: np.ndarray,
@@ -240,12 +287,18 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
     count_pairs = model[8].shape[0]
     rates = segment_rates(path, model)
     start, end = np.empty((2, count_pairs)), np.empty((2, count_pairs))
+    todo = np.empty(count_pairs, dtype=np.bool_)
+    gaps = np.empty((SPHERE_GRID + 1, count_pairs))
+    arms = np.empty((SPHERE_GRID + 1, count_pairs, path.shape[1]))
     count = 0
     for k in range(path.shape[0] - 1):
         for j in range(path.shape[1]):
             scratch[14][j] = abs(path[k + 1, j] - path[k, j])
         _end_bounds(path[k], path[k + 1], 0.0, model, scratch, start)
         _end_bounds(path[k], path[k + 1], 1.0, model, scratch, end)
+        for p in range(count_pairs):
+            todo[p] = rates[k, p] > 0.0 and start[0, p] + end[0, p] <= rates[k, p]
+        _sphere_grid(path[k], path[k + 1], todo, model, scratch, gaps, arms)
         for p in range(count_pairs):
             rate = rates[k, p]
             first = count
@@ -256,8 +309,9 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
                     return -1
                 parameter[count], pair[count], motion[count] = 0.0, p, -1.0
                 count += 1
-            elif start[0, p] + end[0, p] > rate or _sphere_chain(
-                path[k], path[k + 1], p, start[0, p], model, scratch
+            elif not todo[p] or (
+                min(start[1, p], end[1, p]) > SPHERE_CHAIN_ABOVE
+                and _sphere_chain(path[k], path[k + 1], p, start[0, p], model, scratch)
             ):
                 continue  # the sphere gaps prove it apart: no exact query
             else:
