@@ -64,7 +64,7 @@ from lynxplan.planning.kernel_model import (
 STALL_DISTANCE = 2e-4
 #: Pairs whose bounding-sphere gap exceeds the clearance by more than this skip the separating
 #: axis test (its bound cannot limit a step much), in [m].
-SAT_SKIP_DISTANCE = 0.05
+SAT_SKIP_DISTANCE = 0.15
 #: The separating-axis bound tries the 9 edge-edge axes only below this face-axis gap, in [m].
 EDGE_AXES_BELOW = 0.02
 
