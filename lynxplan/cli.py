@@ -20,7 +20,7 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
-from lynxplan import __version__, guards
+from lynxplan import guards
 from lynxplan.exceptions import LynxplanError, LynxplanInputError
 
 #: Negative numbers, including ``-inf`` and ``-nan`` (which the value checks then reject with a
@@ -73,6 +73,25 @@ class _Parser(argparse.ArgumentParser):
         raise SystemExit(EXIT_BAD_INPUT)
 
 
+class _VersionAction(argparse.Action):
+    """``--version``: reads the package metadata only when asked (importlib.metadata costs about
+    30 ms of every start-up otherwise)."""
+
+    def __init__(self, option_strings: list[str], dest: str, **kwargs: Any) -> None:
+        kwargs.setdefault("help", "show the version and exit")
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, **kwargs)
+
+    def __call__(self, parser: argparse.ArgumentParser, *_: Any, **__: Any) -> None:
+        sys.stdout.write(f"lynxplan {_version()}\n")
+        parser.exit()
+
+
+def _version() -> str:
+    import lynxplan
+
+    return str(lynxplan.__version__)
+
+
 def _epilog() -> str:
     lines = ["exit codes:"] + [f"  {code:<4} {meaning}" for code, meaning in EXIT_CODES.items()]
     return "\n".join(lines)
@@ -86,7 +105,7 @@ def build_parser() -> argparse.ArgumentParser:
         epilog=_epilog(),
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    parser.add_argument("--version", action="version", version=f"lynxplan {__version__}")
+    parser.add_argument("--version", action=_VersionAction)
     parser.add_argument(
         "--max-samples",
         metavar="N",
@@ -190,7 +209,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         detail = _one_line(str(exc))[:200]
         _report(
             f"internal error ({type(exc).__name__}{': ' + detail if detail else ''}); this is a "
-            f"bug in lynxplan {__version__}: please file a bug report with the command line and "
+            f"bug in lynxplan {_version()}: please file a bug report with the command line and "
             "the output of the same command with --debug",
             debug,
         )
