@@ -6,12 +6,13 @@ heavy imports off the paths that do not need them.
 
 from __future__ import annotations
 
+import gc
 import subprocess
 import sys
 from importlib.metadata import version
 from pathlib import Path
 
-from lynxplan.cli import main
+from lynxplan.cli import GC_THRESHOLD, main
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -35,3 +36,22 @@ def test_fk_loads_none_of_the_heavy_modules() -> None:
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.splitlines()[-1] == "[]"
+
+
+def test_the_process_entry_tunes_the_garbage_collector(monkeypatch, capsys) -> None:
+    threshold = gc.get_threshold()
+    monkeypatch.setattr(sys, "argv", ["lynxplan", "--version"])
+    try:
+        assert main() == 0
+        assert gc.get_threshold()[0] >= GC_THRESHOLD
+        assert gc.get_freeze_count() > 0  # the exit skips the cycle search of these
+    finally:
+        gc.unfreeze()
+        gc.set_threshold(*threshold)
+    assert capsys.readouterr().out.startswith("lynxplan ")
+
+
+def test_a_call_with_arguments_leaves_the_garbage_collector_alone(capsys) -> None:
+    threshold, frozen = gc.get_threshold(), gc.get_freeze_count()
+    assert main(["--version"]) == 0
+    assert (gc.get_threshold(), gc.get_freeze_count()) == (threshold, frozen)
