@@ -36,14 +36,16 @@ def selected_q(solutions: Sequence[Branch], selected: int | None) -> np.ndarray:
 
 
 class IkSolution(NamedTuple):
-    """One IK branch, checked by forward kinematics.
+    """One IK branch, checked by forward kinematics (the AL5's, and every Robot's as
+    ``lynxplan.robots.RobotIkSolution``).
 
     Attributes:
-        q: Joint angles, shape (5,), in [rad] (read-only).
-        branch: Branch name, e.g. ``"front/elbow-up"``.
+        q: Joint angles, shape (5,) (a Robot's: (n,)), in [rad] (read-only).
+        branch: Branch name, e.g. ``"front/elbow-up"`` or ``"front/roll-1/elbow-up"``.
         within_limits: Whether q is within the joint limits (after snapping).
-        position_error: ``|p_fk(q) - p_target|``, in [m].
-        orientation_error: Angle between the FK rotation and the target, in [rad].
+        position_error: ``|p_fk(q) - p_target|``, in [m] (the miss when unreachable).
+        orientation_error: Angle between the FK rotation and the target (full pose), or between
+            the target and reached approach axes (approach, pitch targets), in [rad].
     """
 
     q: np.ndarray

@@ -57,6 +57,40 @@ def run_pink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
     return ok, times
 
 
+def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
+    """placo's KinematicsSolver (QP, soft frame task, joint limits), iterated to convergence."""
+    import re
+    import tempfile
+
+    import placo
+
+    # IK needs no geometry, and placo cannot resolve package:// mesh URIs: drop the shapes
+    with open(urdf) as handle:
+        text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
+    with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as stripped:
+        stripped.write(text)
+    robot = placo.RobotWrapper(stripped.name, placo.Flags.ignore_collisions)
+    solver = placo.KinematicsSolver(robot)
+    solver.mask_fbase(True)
+    task = solver.add_frame_task(tool, np.eye(4))
+    task.configure(tool, "soft", 1.0, 1.0)
+    ok, times = [], []
+    for target in poses:
+        for name in robot.joint_names():
+            robot.set_joint(name, 0.0)
+        robot.update_kinematics()
+        task.T_world_frame = target
+        start = time.perf_counter()
+        for _ in range(200):
+            solver.solve(True)
+            robot.update_kinematics()
+            if _ok(robot.get_T_world_frame(tool), target):
+                break
+        times.append(time.perf_counter() - start)
+        ok.append(_ok(robot.get_T_world_frame(tool), target))
+    return ok, times
+
+
 def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     from ikpy.chain import Chain
 
@@ -81,9 +115,9 @@ def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
 def main() -> None:
     peer, urdf, tool, poses_path, out = sys.argv[1:6]
     poses = np.load(poses_path)
-    runner = {"pink": run_pink, "ikpy": run_ikpy}[peer]
+    runner = {"pink": run_pink, "ikpy": run_ikpy, "placo": run_placo}[peer]
     ok, times = runner(urdf, tool, poses)
-    package = {"pink": "pin-pink", "ikpy": "ikpy"}[peer]
+    package = {"pink": "pin-pink", "ikpy": "ikpy", "placo": "placo"}[peer]
     with open(out, "w") as handle:
         json.dump(
             {

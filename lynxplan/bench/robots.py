@@ -49,7 +49,8 @@ def _round_trips(robot: object, count: int, seed: int) -> tuple[float, float, fl
     return solved / count, worst, seconds / count
 
 
-#: Peers run in their own virtual environments: PEERS_DIR/<peer>/bin/python (pink, ikpy).
+#: Peers run in their own virtual environments: PEERS_DIR/<peer>/bin/python (placo, pink, ikpy;
+#: placo 0.10 needs pin 3.8, which conflicts with lynxplan's pin 4).
 PEERS_DIR = os.environ.get("LYNXPLAN_PEERS_DIR", "/work/peers")
 
 
@@ -60,7 +61,7 @@ def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
     with tempfile.TemporaryDirectory() as folder:
         poses_path = Path(folder) / "poses.npy"
         np.save(poses_path, poses)
-        for peer in ("pink", "ikpy"):
+        for peer in ("placo", "pink", "ikpy"):
             python = Path(PEERS_DIR) / peer / "bin" / "python"
             if not python.is_file():
                 continue

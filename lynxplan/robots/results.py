@@ -7,26 +7,11 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lynxplan.arm.ik_result import selected_q
+from lynxplan.arm.ik_result import IkSolution, selected_q
 
-
-class RobotIkSolution(NamedTuple):
-    """One IK branch, verified by forward kinematics on the exact model.
-
-    Attributes:
-        q: Joint angles, shape (n,), in [rad] (read-only).
-        branch: Branch name, e.g. ``"front/elbow-up"`` or ``"back/elbow-down/roll-1"``.
-        within_limits: Whether q is within the joint limits (after snapping).
-        position_error: ``|p_fk(q) - p_target|``, in [m] (the miss when unreachable).
-        orientation_error: Angle to the target orientation (full pose) or between the target
-            and reached approach axes (approach, pitch targets), in [rad].
-    """
-
-    q: np.ndarray
-    branch: str
-    within_limits: bool
-    position_error: float
-    orientation_error: float
+#: One IK branch of any robot, verified by FK on the exact model: the AL5's branch type (one
+#: type for both; its ``q`` has shape (n,) here).
+RobotIkSolution = IkSolution
 
 
 @dataclass(frozen=True)

@@ -1,7 +1,8 @@
 """A robot arm loaded from URDF: one surface for every arm (FK, IK, Jacobian, tracking, limits).
 
 IK picks its solver from the geometry: the closed form (with a roll root search for an off-axis
-tool) when the chain is yaw-pitch-pitch-pitch-roll, the numerical solver otherwise. The AL5
+tool where the orientation does not give the roll: approach targets, poses out of reach) when
+the chain is yaw-pitch-pitch-pitch-roll, the numerical solver otherwise. The AL5
 hands poses and approach targets to the existing :class:`lynxplan.arm.model.Arm` kernels, so its
 numbers are those of ``lynxplan.arm``.
 
@@ -13,8 +14,11 @@ straight down towards the outward direction of the arm plane; the AL5's q2 + q3 
 
 from __future__ import annotations
 
+import functools
+import importlib
 from functools import cached_property
 from pathlib import Path
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -46,6 +50,12 @@ __all__ = [
     "Target",
     "make_target",
 ]
+
+
+@functools.cache
+def _family_solver() -> ModuleType:
+    """The family solver module, imported on first use (it loads the numba kernels)."""
+    return importlib.import_module("lynxplan.robots.ik.family_solver")
 
 
 class Robot:
@@ -107,7 +117,7 @@ class Robot:
             return "numerical (Levenberg-Marquardt, multi-start)"
         name = "yaw-pitch3-roll closed form"
         if not self.family.tool_on_roll_axis:
-            name += " + roll root search (off-axis tool)"
+            name += " + roll root search (off-axis tool; reachable poses: roll from orientation)"
         if not self.family.exact:
             name += f" + Newton polish (model off the family by {self.family.deviation:.2g} rad)"
         if self._arm is not None:
@@ -218,9 +228,14 @@ class Robot:
         return np.array(self.family.approach_in_tool)
 
     # -- inverse kinematics --------------------------------------------------------------------
+    @cached_property
+    def _default_reference(self) -> np.ndarray:
+        """Zeros clipped into the limits, shape (1, n), [rad] (the kernels only read it)."""
+        return np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
+
     def _reference(self, q_reference: Any, n: int) -> np.ndarray:
         if q_reference is None:
-            return np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
+            return self._default_reference
         ref = np.ascontiguousarray(as_array(q_reference, "q_reference", (self.nq,)))
         if ref.shape[0] not in (1, n):
             raise ShapeError("q_reference", f"({self.nq},) or ({n}, {self.nq})", ref.shape)
@@ -298,6 +313,23 @@ class Robot:
             raise ShapeError("pose", "(4, 4)", np.shape(pose))
         if select != "nearest":
             raise TargetError(f"select must be 'nearest' for a Robot. Got: {select!r}")
+        if (
+            pose is not None
+            and position is None
+            and approach is None
+            and pitch is None
+            and roll is None
+            and not approach_only
+            and self.family is not None
+            and self._arm is None
+        ):
+            # the lean path; a NaN/inf pose finds no branch there and is rejected below
+            reference = self._reference(q_reference, 1)
+            one: RobotIkResult | None = _family_solver().solve_pose_one(
+                self, np.ascontiguousarray(pose, dtype=float), reference[0], verify
+            )
+            if one is not None:
+                return one
         if approach_only:
             if pose is None:
                 raise TargetError("approach_only needs a pose (position and approach columns)")

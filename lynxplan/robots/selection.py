@@ -32,26 +32,46 @@ def select_one(
     """The branches of the single target of ``batch``, the one nearest ``reference`` (n,) [rad]
     selected among those within the limits that reach the target (or come nearest)."""
     slots = np.flatnonzero(batch.valid[0])
-    q = np.array(batch.q[0, slots])  # fresh; each solution's q is a read-only row of it
-    q.setflags(write=False)
     names = batch.branch_names
+    return assemble_result(
+        robot,
+        batch.q[0, slots],
+        [names[b] for b in slots.tolist()],
+        batch.within_limits[0, slots].tolist(),
+        batch.position_error[0, slots].tolist(),
+        batch.orientation_error[0, slots].tolist(),
+        bool(batch.reachable[0]),
+        float(batch.distance[0]),
+        reference,
+        verify,
+    )
+
+
+def assemble_result(
+    robot: Robot,
+    q: np.ndarray,
+    names: list[str],
+    within: list[bool],
+    position_error: list[float],
+    orientation_error: list[float],
+    reachable: bool,
+    distance: float,
+    reference: np.ndarray,
+    verify: bool,
+) -> RobotIkResult:
+    """One target's result from its branches q (k, n) [rad] (a fresh array; made read-only)
+    and per-branch lists: the one nearest ``reference`` (n,) [rad] selected among those within
+    the limits that reach the target (or come nearest)."""
+    q.setflags(write=False)
     # plain Python on the few branches: cheaper than numpy calls on arrays this small
     rows = q.tolist()
     solutions = [
-        RobotIkSolution(q[i], names[b], w, p, o)
-        for i, (b, w, p, o) in enumerate(
-            zip(
-                slots.tolist(),
-                batch.within_limits[0, slots].tolist(),
-                batch.position_error[0, slots].tolist(),
-                batch.orientation_error[0, slots].tolist(),
-                strict=True,
-            )
-        )
+        RobotIkSolution(q[i], names[i], within[i], position_error[i], orientation_error[i])
+        for i in range(len(names))
     ]
     if verify:
         verify_branches(robot, solutions)
-    limit = float(batch.distance[0]) + REACH_TOLERANCE
+    limit = distance + REACH_TOLERANCE
     ref = reference.tolist()
     best, best_cost = None, math.inf
     for i, s in enumerate(solutions):
@@ -66,14 +86,7 @@ def select_one(
         else (int(np.argmin([s.orientation_error for s in solutions])) if solutions else None)
     )
     residual = float(solutions[ranked].orientation_error) if ranked is not None else np.nan
-    return RobotIkResult(
-        tuple(solutions),
-        best,
-        bool(batch.reachable[0]),
-        float(batch.distance[0]),
-        residual,
-        robot.ik_solver,
-    )
+    return RobotIkResult(tuple(solutions), best, reachable, distance, residual, robot.ik_solver)
 
 
 def verify_branches(robot: Robot, solutions: list[RobotIkSolution]) -> None:

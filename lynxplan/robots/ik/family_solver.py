@@ -8,7 +8,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from lynxplan.robots.ik import family_kernel as fk_
-from lynxplan.robots.results import RobotIkBatch
+from lynxplan.robots.ik import pose_kernel as _pk
+from lynxplan.robots.results import RobotIkBatch, RobotIkResult
+from lynxplan.robots.selection import assemble_result
 
 if TYPE_CHECKING:
     from lynxplan.robots.robot import Robot, Target
@@ -59,6 +61,8 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         perr.fill(np.nan)
         oerr.fill(np.nan)
         rest = ~_al5_fill(robot, target, reference, q, valid, within, perr, oerr)
+    elif target.kind == fk_.MODE_POSE:
+        rest = ~_pose_fill(robot, target, reference, q, valid, within, perr, oerr)
     if rest is None or rest.all():
         _kernel(robot, target, reference, q, valid, within, perr, oerr)
     elif rest.any():
@@ -210,6 +214,70 @@ def _kernel(
         oerr,
         miss,
     )
+
+
+def solve_pose_one(
+    robot: Robot, pose: np.ndarray, reference: np.ndarray, verify: bool
+) -> RobotIkResult | None:
+    """One full pose (4, 4) with the roll free, the lean way (one kernel call, no batch
+    arrays): the result, or None where the pose needs the general path (not reached exactly by
+    the orientation's closed form: out of reach or degenerate). ``reference`` (n,) [rad]."""
+    family = robot.family
+    assert family is not None
+    slots = 4 if family.tool_on_roll_axis else 4 * fk_.MAX_ROOTS
+    table = np.empty((slots, _pk.SLOT_COLUMNS))
+    chain = robot.chain
+    count = _pk.pose_one(family.packed, chain.placements, chain.axes, pose, reference, slots, table)
+    if count == 0:
+        return None
+    q = table[:count, :5].copy()
+    rows = table[:count].tolist()
+    names = branch_names(slots)
+    errors = [row[_pk.COMPACT_POSITION_ERROR] for row in rows]
+    return assemble_result(
+        robot,
+        q,
+        [names[int(row[_pk.SLOT])] for row in rows],
+        [row[_pk.COMPACT_WITHIN] != 0.0 for row in rows],
+        errors,
+        [row[_pk.COMPACT_ORIENTATION_ERROR] for row in rows],
+        True,
+        min(errors),
+        reference,
+        verify,
+    )
+
+
+def _pose_fill(
+    robot: Robot,
+    target: Target,
+    reference: np.ndarray,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    perr: np.ndarray,
+    oerr: np.ndarray,
+) -> np.ndarray:
+    """Full poses the orientation solves in closed form (``pose_kernel``); returns which. The
+    others (out of reach, degenerate, a given roll) need the general kernel (root search)."""
+    family = robot.family
+    assert family is not None
+    solved = np.empty(target.poses.shape[0], dtype=np.bool_)
+    _pk.pose_kernel(
+        family.packed,
+        robot.chain.placements,
+        robot.chain.axes,
+        target.poses,
+        reference,
+        q,
+        valid,
+        within,
+        perr,
+        oerr,
+        solved,
+    )
+    solved &= np.isnan(target.roll)
+    return solved
 
 
 def _al5_fill(

@@ -1,0 +1,319 @@
+"""Numba kernel: full poses of an off-axis tool in closed form, before any root search.
+
+A full target pose fixes the orientation, and the orientation of a yaw-pitch-pitch-pitch-roll
+arm fixes its yaw, pitch sum and roll up to one flip: the yaw puts the approach axis in the arm
+plane (``phi`` or ``phi + pi``), the pitch sum follows from the approach in that plane, the roll
+is the best roll about the approach axis. With the roll known the tool point is fixed in the
+wrist link and the branch is closed-form (``family_geometry.branch``: two elbows). A target is
+*solved here* when one of these branches reaches the pose exactly on the exact chain
+(position and orientation to :data:`POSE_EXACT`); every exact branch of the pose has this
+orientation, so no other branch exists. Targets not solved here (the pose is out of reach, so
+the nearest orientation is wanted; the approach along the yaw axis; a target near the yaw axis
+of a near-family model) go to the roll root search of ``family_kernel``.
+
+Slots are those of the kernel's layouts, so one batch has one layout: ``side * 2 + elbow``
+(tool on the roll axis: each flip is one side) or ``side * per_side + 2 * flip + elbow`` (the
+root-search layout, the flip in the place of the root index). Angles in [rad], lengths in [m].
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from lynxplan.arm.ik_kernel import wrap_into_limits
+from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
+from lynxplan.robots.ik.family_geometry import MODE_POSE, best_roll, branch, pitch_sum, wrap, yaw
+from lynxplan.robots.ik.family_polish import branch_orientation_error, lu_factor, lu_solve
+
+#: A branch reaches a full pose exactly within this position [m] and orientation [rad] error.
+POSE_EXACT = 1e-9
+#: The yaw one side of the lateral offset gives must match the orientation's within this [rad],
+#: plus YAW_MATCH_LENGTH / (distance from the yaw axis) (the ideal model's tool point differs
+#: from the exact chain's by ~1e-6 m for the SO-101, which turns the yaw more near the axis).
+YAW_MATCH, YAW_MATCH_LENGTH = 1e-3, 1e-4
+#: The approach this close to the yaw axis leaves the yaw to the position: root search.
+AXIAL_APPROACH = 1e-6
+#: A closed-form branch that misses the reach by more than this [m] is not polished.
+REACH_MISS = 1e-5
+#: Gauss-Newton iterations of the polish at most, and the pose error at which it stops.
+NEWTON_STEPS = 60
+NEWTON_TOLERANCE = 1e-15
+#: An iteration must divide the error by at least this much, or the polish stops: from a
+#: closed-form start it falls quadratically (1e-6, 1e-12, ...), next to a fold of the elbow
+#: (a double root: the error ~ the square of the joint gap, which Newton halves) by ~4 per
+#: step; a start that is not near an exact branch falls slower and stops early.
+MIN_FALL = 2.0
+
+
+@numba.njit(cache=True, nogil=True)
+def polish_pose(
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+    jac: np.ndarray,
+    origins: np.ndarray,
+    normal: np.ndarray,
+) -> None:
+    """Gauss-Newton on the pose error of the exact chain, from a closed-form branch of the
+    nearly identical ideal model (~1e-6 away): position error [m] and the rotation vector
+    vee(R Rt^T - Rt R^T) / 2 [rad] against the geometric Jacobian (6, 5). The target is reachable
+    exactly (zero residual), so it converges quadratically (linearly next to a fold of the
+    elbow); stops when the error stops falling by MIN_FALL.
+
+    Scratch: pose, work (4, 4); jac (6, 5); origins (5, 6); normal (7, 5): J^T J, its LU row
+    order, and J^T e.
+    """
+    previous = math.inf
+    e = np.empty(6)
+    step = np.empty(5)
+    for _ in range(NEWTON_STEPS):
+        chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
+        for i in range(3):
+            e[i] = pose[i, 3] - target[i, 3]
+        # R Rt^T - Rt R^T, its vee / 2: the small rotation from the target to the pose
+        m01 = m10 = m02 = m20 = m12 = m21 = 0.0
+        for k in range(3):
+            m01 += pose[0, k] * target[1, k]
+            m10 += pose[1, k] * target[0, k]
+            m02 += pose[0, k] * target[2, k]
+            m20 += pose[2, k] * target[0, k]
+            m12 += pose[1, k] * target[2, k]
+            m21 += pose[2, k] * target[1, k]
+        e[3], e[4], e[5] = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
+        size = 0.0
+        for i in range(6):
+            size = max(size, abs(e[i]))
+        if size < NEWTON_TOLERANCE or not size * MIN_FALL <= previous:
+            return
+        previous = size
+        for i in range(5):
+            total = 0.0
+            for k in range(6):
+                total += jac[k, i] * e[k]
+            normal[6, i] = total
+            for j in range(5):
+                total = 0.0
+                for k in range(6):
+                    total += jac[k, i] * jac[k, j]
+                normal[i, j] = total
+        if not lu_factor(normal[:6]):
+            return
+        lu_solve(normal[:6], normal[6], step)
+        for j in range(5):
+            q[j] -= step[j]
+
+
+#: Columns of one target's slot table (``solve_target``): q (5), then these.
+VALID, WITHIN, POSITION_ERROR, ORIENTATION_ERROR = 5, 6, 7, 8
+SLOT_COLUMNS = 9
+
+
+@numba.njit(cache=True, nogil=True)
+def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the candidates)
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    ref: np.ndarray,
+    out: np.ndarray,
+    g: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+    q: np.ndarray,
+    jac: np.ndarray,
+    origins: np.ndarray,
+    normal: np.ndarray,
+) -> bool:
+    """The exact branches of one full pose (4, 4) where the orientation gives the roll, into
+    the slot table out (B, SLOT_COLUMNS) (every slot written; NaN / 0 where no branch); ref (5,)
+    [rad]. Returns whether an exact branch was found (the target is complete). The rest:
+    scratch, g (3, 4), pose and work (4, 4), q (5,), jac (6, 5), origins (5, 6), normal (7, 5).
+    """
+    nb = out.shape[0]
+    per_side = nb // 2
+    lower, upper = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5]
+    tol = prm[F.LIMIT_TOL]
+    rt0 = prm[F.RT0 : F.RT0 + 9]
+    exact_model = prm[F.EXACT] != 0.0
+    for b in range(nb):
+        for j in range(5):
+            out[b, j] = np.nan
+        out[b, VALID] = 0.0
+        out[b, WITHIN] = 0.0
+        out[b, POSITION_ERROR] = np.nan
+        out[b, ORIENTATION_ERROR] = np.nan
+    phi_ref = prm[F.SIGMA] * ref[0]
+    sum_ref = prm[F.SIGMA + 1] * ref[1] + prm[F.SIGMA + 2] * ref[2] + prm[F.SIGMA + 3] * ref[3]
+    for i in range(3):  # G = Rt Rt0^T, approach = G r
+        for j in range(3):
+            g[i, j] = (
+                target[i, 0] * rt0[3 * j]
+                + target[i, 1] * rt0[3 * j + 1]
+                + target[i, 2] * rt0[3 * j + 2]
+            )
+    for i in range(3):
+        g[i, 3] = g[i, 0] * prm[F.R] + g[i, 1] * prm[F.R + 1] + g[i, 2] * prm[F.R + 2]
+    a_h = g[0, 3] * prm[F.H] + g[1, 3] * prm[F.H + 1] + g[2, 3] * prm[F.H + 2]
+    a_p = g[0, 3] * prm[F.P] + g[1, 3] * prm[F.P + 1] + g[2, 3] * prm[F.P + 2]
+    if math.hypot(a_h, a_p) <= AXIAL_APPROACH:
+        return False
+    d0 = target[0, 3] - prm[F.C1]
+    d1 = target[1, 3] - prm[F.C1 + 1]
+    d2 = target[2, 3] - prm[F.C1 + 2]
+    rho = math.hypot(
+        d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2],
+        d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2],
+    )
+    match = YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12)
+    solved = False
+    for flip in range(2):
+        # the yaw that puts the approach in the arm plane (its outward component > 0 or < 0)
+        phi = math.atan2(-a_p, a_h) + flip * math.pi
+        big_phi, _ = pitch_sum(prm, MODE_POSE, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
+        theta = best_roll(prm, g, phi, big_phi)
+        for side in range(2):
+            phi_side, lateral = yaw(prm, d0, d1, d2, theta, side, phi_ref)
+            if lateral > REACH_MISS or abs(wrap(phi_side - phi)) > match:
+                continue
+            problem = (prm, target, g, MODE_POSE, side, phi_ref, sum_ref)
+            for elbow in range(2):
+                b = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
+                if out[b, VALID] != 0.0:
+                    continue
+                if branch(problem, 0.0, theta, elbow, q) > REACH_MISS:
+                    continue
+                if not exact_model:
+                    polish_pose(placements, axes, target, q, pose, work, jac, origins, normal)
+                inside = True
+                for j in range(5):
+                    x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)
+                    q[j] = x
+                    inside = inside and ok
+                chain_fk(placements, axes, q, pose, work)
+                err = 0.0
+                for i in range(3):
+                    e = pose[i, 3] - target[i, 3]
+                    err += e * e
+                err = math.sqrt(err)
+                angle = branch_orientation_error(prm, target, g, MODE_POSE, 0.0, q, pose)
+                if not (err <= POSE_EXACT and angle <= POSE_EXACT):
+                    continue
+                duplicate = False
+                for b2 in range(nb):
+                    if out[b2, VALID] != 0.0:
+                        gap = 0.0
+                        for j in range(5):
+                            gap = max(gap, abs(out[b2, j] - q[j]))
+                        duplicate = duplicate or gap < 1e-9
+                if duplicate:
+                    continue
+                for j in range(5):
+                    out[b, j] = q[j]
+                out[b, VALID] = 1.0
+                out[b, WITHIN] = 1.0 if inside else 0.0
+                out[b, POSITION_ERROR] = err
+                out[b, ORIENTATION_ERROR] = angle
+                solved = True
+    return solved
+
+
+#: Columns of ``pose_one``'s compact table: q (5), then these.
+SLOT, COMPACT_WITHIN, COMPACT_POSITION_ERROR, COMPACT_ORIENTATION_ERROR = 5, 6, 7, 8
+
+
+@numba.njit(cache=True, nogil=True)
+def pose_one(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    ref: np.ndarray,
+    slots: int,
+    compact: np.ndarray,
+) -> int:
+    """``solve_target`` of one pose (4, 4), ref (5,) [rad], in a layout of ``slots`` slots.
+
+    Returns the number k of exact branches (0: not solved here), written to compact[:k]
+    (rows: q (5) [rad], slot index, within limits 1/0, position error [m], orientation error
+    [rad]); compact has shape (slots, SLOT_COLUMNS).
+    """
+    out = np.empty((slots, SLOT_COLUMNS))
+    solved = solve_target(
+        prm,
+        placements,
+        axes,
+        target,
+        ref,
+        out,
+        np.empty((3, 4)),
+        np.empty((4, 4)),
+        np.empty((4, 4)),
+        np.empty(5),
+        np.empty((6, 5)),
+        np.empty((5, 6)),
+        np.empty((7, 5)),
+    )
+    if not solved:
+        return 0
+    k = 0
+    for b in range(slots):
+        if out[b, VALID] != 0.0:
+            for j in range(5):
+                compact[k, j] = out[b, j]
+            compact[k, SLOT] = b
+            compact[k, COMPACT_WITHIN] = out[b, WITHIN]
+            compact[k, COMPACT_POSITION_ERROR] = out[b, POSITION_ERROR]
+            compact[k, COMPACT_ORIENTATION_ERROR] = out[b, ORIENTATION_ERROR]
+            k += 1
+    return k
+
+
+@numba.njit(cache=True, nogil=True)
+def pose_kernel(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    targets: np.ndarray,
+    reference: np.ndarray,
+    q_out: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+    solved: np.ndarray,
+) -> None:
+    """``solve_target`` of N full poses, in the batch arrays.
+
+    Args:
+        prm, placements, axes: Packed family parameters and the exact chain.
+        targets: (N, 4, 4) target poses.
+        reference: (N, 5) or (1, 5) joint angles [rad] (the yaw kept on the base axis).
+        q_out, valid, within, position_error, orientation_error: (N, B, ...) outputs in the
+            kernel's layout; every slot of every target is written.
+        solved: (N,) output: True where an exact branch was found (the target is complete).
+    """
+    nb = q_out.shape[1]
+    out = np.empty((nb, SLOT_COLUMNS))
+    g = np.empty((3, 4))
+    pose, work = np.empty((4, 4)), np.empty((4, 4))
+    q = np.empty(5)
+    jac, origins, normal = np.empty((6, 5)), np.empty((5, 6)), np.empty((7, 5))
+    for n in range(targets.shape[0]):
+        ref = reference[n if reference.shape[0] > 1 else 0]
+        solved[n] = solve_target(
+            prm, placements, axes, targets[n], ref, out, g, pose, work, q, jac, origins, normal
+        )
+        for b in range(nb):
+            for j in range(5):
+                q_out[n, b, j] = out[b, j]
+            valid[n, b] = out[b, VALID] != 0.0
+            within[n, b] = out[b, WITHIN] != 0.0
+            position_error[n, b] = out[b, POSITION_ERROR]
+            orientation_error[n, b] = out[b, ORIENTATION_ERROR]

@@ -1,0 +1,122 @@
+"""Full poses solved through the orientation (``pose_kernel``) against the roll root search.
+
+The closed form from the orientation must give exactly the exact branches the general kernel
+(roll root search, Newton polish, near-axis rescue) gives, on random poses, poses near the yaw
+axis and random family URDFs; the single-pose path must agree with the batch.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lynxplan.robots import Robot, load_robot
+from lynxplan.robots.ik import family_solver
+from lynxplan.robots.targets import make_target
+from tests.robots.urdf_factory import write_random_family_urdfs
+
+#: Exact branches: reach the pose to these [m], [rad] (the completeness test's criterion).
+EXACT = 1e-9
+
+
+def _general(robot: Robot, poses: np.ndarray) -> list[np.ndarray]:
+    """The exact branches of each pose from the general kernel (root search + rescue)."""
+    target = make_target(poses)
+    n, slots = poses.shape[0], 4 * family_solver.fk_.MAX_ROOTS
+    assert robot.family is not None
+    if robot.family.tool_on_roll_axis:
+        slots = 4
+    q = np.empty((n, slots, 5))
+    valid = np.empty((n, slots), dtype=bool)
+    within = np.empty((n, slots), dtype=bool)
+    perr, oerr = np.empty((n, slots)), np.empty((n, slots))
+    reference = robot._default_reference
+    family_solver._kernel(robot, target, reference, q, valid, within, perr, oerr)
+    family_solver.rescue_near_axis(robot, target, q, valid, within, perr, oerr)
+    exact = valid & (perr <= EXACT) & (oerr <= EXACT)
+    return [q[i][exact[i]] for i in range(n)]
+
+
+def _same_sets(a: np.ndarray, b: np.ndarray) -> bool:
+    if len(a) != len(b):
+        return False
+    return all(np.abs(b - x).max(axis=1).min() < 1e-7 for x in a)
+
+
+def _near_axis_poses(robot: Robot, count: int, seed: int) -> np.ndarray:
+    """Poses whose tool point is within 4 cm of the yaw axis (where the yaw is sensitive)."""
+    assert robot.family is not None
+    q = robot.random_configurations(100 * count, seed=seed)
+    poses = robot.fk(q)
+    k = np.array(robot.family.yaw_axis)
+    d = poses[:, :3, 3] - robot.family.packed[0:3]
+    rho = np.linalg.norm(d - np.outer(d @ k, k), axis=1)
+    return np.ascontiguousarray(poses[rho < 0.04][:count])
+
+
+@pytest.mark.parametrize("name", ["so101", "so100"])
+def test_orientation_closed_form_matches_root_search(name: str) -> None:
+    robot = load_robot(name)
+    poses = np.concatenate(
+        (robot.fk(robot.random_configurations(1500, seed=11)), _near_axis_poses(robot, 400, 12))
+    )
+    batch = robot.ik_batch(poses)
+    general = _general(robot, poses)
+    for i, pose in enumerate(poses):
+        ours = batch.q[i][
+            batch.valid[i]
+            & (batch.position_error[i] <= EXACT)
+            & (batch.orientation_error[i] <= EXACT)
+        ]
+        assert len(ours) > 0, i  # every pose here comes from FK: reachable
+        assert _same_sets(ours, general[i]), (i, ours, general[i])
+        if i % 50 == 0:  # the single-pose path gives the same branches, one selected
+            one = robot.ik(pose)
+            assert _same_sets(np.array([s.q for s in one.solutions]), ours)
+            assert one.selected is not None and one.reachable
+
+
+def test_random_off_axis_urdfs_match_root_search(tmp_path: Path) -> None:
+    for path in write_random_family_urdfs(tmp_path, 9, seed=99):
+        robot = load_robot(path, tool="tool")
+        assert robot.family is not None
+        poses = robot.fk(robot.random_configurations(200, seed=3))
+        batch = robot.ik_batch(poses)
+        general = _general(robot, poses)
+        for i in range(len(poses)):
+            ours = batch.q[i][batch.valid[i] & (batch.orientation_error[i] <= EXACT)]
+            assert _same_sets(ours, general[i]), (path.name, i)
+
+
+def test_out_of_reach_pose_falls_back_to_the_nearest() -> None:
+    robot = load_robot("so101")
+    pose = robot.fk(robot.random_configurations(1, seed=5)[0])
+    pose[:3, 3] *= 4.0  # far out of reach: no exact branch, the root search's nearest
+    one = robot.ik(pose)
+    assert not one.reachable and one.distance > 0.1
+    assert one.solutions
+    batch = robot.ik_batch(pose[None])
+    assert not batch.reachable[0]
+    assert batch.distance[0] == pytest.approx(one.distance, abs=1e-12)
+
+
+def test_poses_next_to_a_fold_of_the_elbow_round_trip() -> None:
+    """The SO-101's elbow folds near q3 = -1.28849 rad (its built-in link angles): there the
+    two elbow branches are ~1e-5 rad apart on the exact chain and Newton converges linearly.
+    The start configuration must still come back to 1e-7 rad (found by the 1e6 round trips)."""
+    robot = load_robot("so101")
+    base = np.array([-0.5369933, 0.83660157, -1.28849203, 0.46747002, 1.75448164])
+    starts = [base]
+    for shift in (-1e-3, -1e-4, -1e-5, 1e-5, 1e-4, 1e-3):
+        q = base.copy()
+        q[2] += shift
+        q[3] -= shift  # keep the pitch sum
+        starts.append(q)
+    q0 = np.array(starts)
+    batch = robot.ik_batch(robot.fk(q0))
+    assert batch.reachable.all()
+    gap = np.where(batch.valid[..., None], np.abs(batch.q - q0[:, None, :]), np.inf)
+    assert gap.max(axis=2).min(axis=1).max() < 1e-7
+    assert np.where(batch.valid, batch.position_error, 0.0).max() <= 1e-12
