@@ -46,7 +46,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from lynxplan import guards
-from lynxplan.collision.world import CollisionWorld, _configurations
+from lynxplan.collision.world import CollisionWorld, _configurations, reach_products
 from lynxplan.exceptions import LynxplanError, NonFiniteInputError, ShapeError, TrajectoryCheckError
 
 #: Bisection levels of one sample interval before it is reported as not certified.
@@ -366,4 +366,4 @@ def _interpolation_margins(world: CollisionWorld, bound: Any, times: np.ndarray)
         )
     # Linear interpolation error of a C2 function: |q - lerp| <= max|q''| dt^2 / 8 per joint.
     joint_error = np.diff(times)[:, None] ** 2 / 8.0 * acceleration  # (N - 1, nq)
-    return np.asarray((joint_error @ world._reach.T).max(axis=1))
+    return np.asarray(reach_products(joint_error, world._reach).max(axis=1))
