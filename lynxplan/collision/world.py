@@ -104,6 +104,7 @@ class CollisionWorld:
         self.pair_is_self = np.array([p[2] for p in pairs], dtype=bool)
         for array in (self.pair_link, self.pair_other, self.pair_is_self):
             array.setflags(write=False)
+        self._pairs = tuple(pairs)  # (link, other, is_self) as Python values, for the queries
         if engine == "fcl":
             self._build_fcl()
         shapes = [p.shape for p in self.links]
@@ -222,13 +223,12 @@ class CollisionWorld:
     ) -> tuple[Any, Any]:
         """The engine objects of one pair, the links' moved to ``poses`` (G, 4, 4) [m]: ``links``
         and ``obstacles`` are one engine's placements (coal ``Transform3f``, fcl objects)."""
-        a = int(self.pair_link[pair])
+        a, b, is_self = self._pairs[pair]
         first = links[a]
         first.setRotation(poses[a, :3, :3])
         first.setTranslation(poses[a, :3, 3])
-        if not self.pair_is_self[pair]:
-            return first, obstacles[int(self.pair_other[pair])]
-        b = int(self.pair_other[pair])
+        if not is_self:
+            return first, obstacles[b]
         second = links[b]
         second.setRotation(poses[b, :3, :3])
         second.setTranslation(poses[b, :3, 3])
