@@ -91,13 +91,24 @@ def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list
     return ok, times
 
 
+def _root_link(urdf: str) -> str:
+    """The URDF's root link: the one link that is no joint's child."""
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(urdf).getroot()
+    children = {c.get("link") for c in tree.iter("child")}
+    roots = [link.get("name") for link in tree.iter("link") if link.get("name") not in children]
+    return str(roots[0]) if roots else "base_link"
+
+
 def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     from ikpy.chain import Chain
 
-    chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=["base_link"])
+    base = [_root_link(urdf)]
+    chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=base)
     names = [link.name for link in chain.links]
     mask = [link.joint_type != "fixed" for link in chain.links]
-    chain = Chain.from_urdf_file(urdf, base_elements=["base_link"], active_links_mask=mask)
+    chain = Chain.from_urdf_file(urdf, base_elements=base, active_links_mask=mask)
     ok, times = [], []
     for target in poses:
         start = time.perf_counter()

@@ -27,6 +27,12 @@ def register(subparsers: Any) -> None:
     )
     parser.add_argument("--quick", action="store_true", help="fewer repeats (smoke test)")
     parser.add_argument("--json", action="store_true", help="print JSON instead of a table")
+    group = parser.add_mutually_exclusive_group()
+    group.add_argument(
+        "--robot", help="IK figures of this built-in robot only (al5, so100, so101), with peers"
+    )
+    group.add_argument("--urdf", help="IK figures of this URDF robot only (with --tool)")
+    parser.add_argument("--tool", help="tool frame of --robot/--urdf (default: the robot's tool)")
     parser.set_defaults(handler=handle)
 
 
@@ -36,7 +42,16 @@ def handle(args: argparse.Namespace) -> int:
     if unknown:
         raise InputError(f"unknown bench section {unknown[0]!r}; sections: {', '.join(SECTIONS)}")
     sections = ["cold"] if args.cold else (args.section or []) + args.sections or None
-    figures = run_sections(sections, quick=args.quick)
+    if args.robot or args.urdf or args.tool:
+        if sections or args.cold:
+            raise InputError("--robot/--urdf/--tool run the robot section alone; drop the sections")
+        from lynxplan.bench.robots import run_robot
+        from lynxplan.robots import load_robot
+
+        robot = load_robot(args.urdf or args.robot or "al5", tool=args.tool)
+        figures = run_robot(robot, quick=args.quick)
+    else:
+        figures = run_sections(sections, quick=args.quick)
     if args.json:
         print_json({"figures": [f._asdict() for f in figures]})
         return 0

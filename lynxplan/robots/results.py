@@ -46,6 +46,50 @@ class RobotIkResult:
         return selected_q(self.solutions, self.selected)
 
 
+class BranchSlots(NamedTuple):
+    """The arrays the IK kernels write for N targets and B branch slots (internal; the batch
+    result is made of them): empty slots NaN / False."""
+
+    q: np.ndarray
+    """(N, B, n) [rad]."""
+    valid: np.ndarray
+    """(N, B) bool."""
+    within: np.ndarray
+    """(N, B) bool."""
+    position_error: np.ndarray
+    """(N, B) [m]."""
+    orientation_error: np.ndarray
+    """(N, B) [rad]."""
+
+    @classmethod
+    def empty(cls, n: int, slots: int, nq: int = 5) -> BranchSlots:
+        """Uninitialised arrays (the kernels write every slot of the targets they solve)."""
+        return cls(
+            np.empty((n, slots, nq)),
+            np.empty((n, slots), dtype=np.bool_),
+            np.empty((n, slots), dtype=np.bool_),
+            np.empty((n, slots)),
+            np.empty((n, slots)),
+        )
+
+    def clear(self) -> None:
+        """Every slot empty."""
+        self.q.fill(np.nan)
+        self.valid.fill(False)
+        self.within.fill(False)
+        self.position_error.fill(np.nan)
+        self.orientation_error.fill(np.nan)
+
+    def rows(self, mask: np.ndarray) -> BranchSlots:
+        """A copy of the targets in ``mask`` (N,) bool."""
+        return BranchSlots(*(np.ascontiguousarray(a[mask]) for a in self))
+
+    def put(self, mask: np.ndarray, part: BranchSlots) -> None:
+        """Write ``part`` (from :meth:`rows`) back to the targets in ``mask``."""
+        for whole, piece in zip(self, part, strict=True):
+            whole[mask] = piece
+
+
 class RobotIkBatch(NamedTuple):
     """IK of N targets, every branch slot. Arrays are read-only; empty slots are NaN/False."""
 

@@ -58,6 +58,12 @@ def _family_solver() -> ModuleType:
     return importlib.import_module("lynxplan.robots.ik.family_solver")
 
 
+@functools.cache
+def _al5_bridge() -> ModuleType:
+    """The AL5 delegation module, imported on first use (it loads the numba kernels)."""
+    return importlib.import_module("lynxplan.robots.ik.al5_bridge")
+
+
 class Robot:
     """A robot arm from URDF (see the module docstring).
 
@@ -321,12 +327,14 @@ class Robot:
             and roll is None
             and not approach_only
             and self.family is not None
-            and self._arm is None
         ):
-            # the lean path; a NaN/inf pose finds no branch there and is rejected below
+            # the lean paths; a pose they cannot solve (NaN/inf, out of reach) goes on below
             reference = self._reference(q_reference, 1)
-            one: RobotIkResult | None = _family_solver().solve_pose_one(
-                self, np.ascontiguousarray(pose, dtype=float), reference[0], verify
+            frame = np.ascontiguousarray(pose, dtype=float)
+            one: RobotIkResult | None = (
+                _family_solver().solve_pose_one(self, frame, reference[0], verify)
+                if self._arm is None
+                else _al5_bridge().solve_al5_pose_one(self, frame, reference[0], verify)
             )
             if one is not None:
                 return one

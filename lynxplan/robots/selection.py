@@ -63,16 +63,30 @@ def assemble_result(
     and per-branch lists: the one nearest ``reference`` (n,) [rad] selected among those within
     the limits that reach the target (or come nearest)."""
     q.setflags(write=False)
-    # plain Python on the few branches: cheaper than numpy calls on arrays this small
-    rows = q.tolist()
     solutions = [
         RobotIkSolution(q[i], names[i], within[i], position_error[i], orientation_error[i])
         for i in range(len(names))
     ]
+    return finish_result(robot, solutions, q.tolist(), reachable, distance, reference, verify)
+
+
+def finish_result(
+    robot: Robot,
+    solutions: list[RobotIkSolution],
+    rows: list[list[float]],
+    reachable: bool,
+    distance: float,
+    reference: np.ndarray,
+    verify: bool,
+) -> RobotIkResult:
+    """The result of one target's branches (``rows``: their q as lists): verified by Pinocchio
+    when asked, the one nearest ``reference`` (n,) [rad] selected among those within the limits
+    that reach the target (or come nearest)."""
     if verify:
         verify_branches(robot, solutions)
     limit = distance + REACH_TOLERANCE
     ref = reference.tolist()
+    # plain Python on the few branches: cheaper than numpy calls on arrays this small
     best, best_cost = None, math.inf
     for i, s in enumerate(solutions):
         if not s.within_limits or s.position_error > limit:

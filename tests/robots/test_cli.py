@@ -89,3 +89,21 @@ def test_cli_errors(capsys: pytest.CaptureFixture[str]) -> None:
     assert "so101 has 5 joints; got 2" in capsys.readouterr().err
     assert main(["ik", "--json"]) == 2
     assert "required: --pose (or --position" in capsys.readouterr().err
+
+
+def test_bench_one_robot(
+    capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """``lynxplan bench --robot so100 --quick``: that robot's figures only (peers skipped here:
+    an empty peers folder), the round trips all solved."""
+    import lynxplan.bench.robots as bench_robots
+
+    monkeypatch.setattr(bench_robots, "PEERS_DIR", "/nonexistent-peers")
+    figures = _json(capsys, ["bench", "--robot", "so100", "--quick", "--json"])["figures"]  # type: ignore[index]
+    names = [f["name"] for f in figures]
+    assert all(name.startswith("so100 ") for name in names), names
+    trips = next(f for f in figures if "round trips solved" in f["name"])
+    assert trips["value"] == 100.0 and trips["met"] is True
+    assert any("speed-up over Pinocchio CLIK" in name for name in names)
+    assert main(["bench", "--robot", "so100", "--urdf", "x.urdf"]) == 2  # one or the other
+    assert main(["bench", "arm", "--robot", "so100"]) == 2

@@ -14,6 +14,7 @@ import pytest
 
 from lynxplan.robots import Robot, load_robot
 from lynxplan.robots.ik import family_solver
+from lynxplan.robots.results import BranchSlots
 from lynxplan.robots.targets import make_target
 from tests.robots.urdf_factory import write_random_family_urdfs
 
@@ -28,13 +29,10 @@ def _general(robot: Robot, poses: np.ndarray) -> list[np.ndarray]:
     assert robot.family is not None
     if robot.family.tool_on_roll_axis:
         slots = 4
-    q = np.empty((n, slots, 5))
-    valid = np.empty((n, slots), dtype=bool)
-    within = np.empty((n, slots), dtype=bool)
-    perr, oerr = np.empty((n, slots)), np.empty((n, slots))
-    reference = robot._default_reference
-    family_solver._kernel(robot, target, reference, q, valid, within, perr, oerr)
-    family_solver.rescue_near_axis(robot, target, q, valid, within, perr, oerr)
+    out = BranchSlots.empty(n, slots)
+    family_solver._kernel(robot, target, robot._default_reference, out)
+    family_solver.rescue_near_axis(robot, target, out)
+    q, valid, _, perr, oerr = out
     exact = valid & (perr <= EXACT) & (oerr <= EXACT)
     return [q[i][exact[i]] for i in range(n)]
 
@@ -120,3 +118,22 @@ def test_poses_next_to_a_fold_of_the_elbow_round_trip() -> None:
     gap = np.where(batch.valid[..., None], np.abs(batch.q - q0[:, None, :]), np.inf)
     assert gap.max(axis=2).min(axis=1).max() < 1e-7
     assert np.where(batch.valid, batch.position_error, 0.0).max() <= 1e-12
+
+
+def test_al5_single_pose_path_matches_the_batch() -> None:
+    """Robot('al5').ik goes through Arm.ik; the same branches and selection as the batch."""
+    from lynxplan.robots.selection import select_one
+
+    robot = load_robot("al5")
+    poses = robot.fk(robot.random_configurations(100, seed=8))
+    far = poses[0].copy()
+    far[:3, 3] *= 5.0  # out of reach: the general path's nearest solution
+    for pose in [*poses, far]:
+        one = robot.ik(pose)
+        batch = robot.ik_batch(pose[None])
+        other = select_one(robot, batch, robot._default_reference[0], verify=False)
+        assert one.selected == other.selected and one.reachable == other.reachable
+        np.testing.assert_allclose(
+            [s.q for s in one.solutions], [s.q for s in other.solutions], atol=0
+        )
+        assert one.distance == pytest.approx(other.distance, abs=1e-15)

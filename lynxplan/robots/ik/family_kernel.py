@@ -17,9 +17,7 @@ import math
 import numba
 import numpy as np
 
-from lynxplan.arm.ik_kernel import wrap_into_limits  # one implementation with the AL5's
 from lynxplan.robots import family as F  # noqa: N812
-from lynxplan.robots.chain import chain_fk
 from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
     MODE_PITCH,
@@ -27,7 +25,13 @@ from lynxplan.robots.ik.family_geometry import (
     TWO_PI,
     branch,
 )
-from lynxplan.robots.ik.family_polish import NEWTON_TOLERANCE, branch_orientation_error, polish
+from lynxplan.robots.ik.family_polish import (
+    NEWTON_TOLERANCE,
+    branch_orientation_error,
+    is_duplicate,
+    polish,
+    settle,
+)
 from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms
 from lynxplan.robots.ik.roll_search import GRID_SIZE, MAX_ROOTS, ROOT_GRID, roll_candidates
 
@@ -190,31 +194,15 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         ):
                             rg = q[4]
                         polish(chain_problem, rg, q, scratch, scratch4, scratch5)
-                    inside = True
-                    for j in range(5):
-                        x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)
-                        q_out[n, b, j] = x
-                        q[j] = x
-                        inside = inside and ok
-                    chain_fk(placements, axes, q, pose, work)
-                    err = 0.0
-                    for i in range(3):
-                        d = pose[i, 3] - target[i, 3]
-                        err += d * d
-                    duplicate = False
-                    for b2 in range(b):
-                        if valid[n, b2]:
-                            gap = 0.0
-                            for j in range(5):
-                                gap = max(gap, abs(q_out[n, b2, j] - q[j]))
-                            duplicate = duplicate or gap < DUPLICATE_TOLERANCE
-                    if duplicate:  # the same branch reached twice (merged roots, a fold)
-                        for j in range(5):
-                            q_out[n, b, j] = np.nan
+                    inside, err = settle(placements, axes, lower, upper, tol, target, q, pose, work)
+                    # the same branch reached twice (merged roots, a fold)
+                    if is_duplicate(q_out[n], valid[n], b, q, DUPLICATE_TOLERANCE):
                         continue
+                    for j in range(5):
+                        q_out[n, b, j] = q[j]
                     valid[n, b] = True
                     within[n, b] = inside
-                    position_error[n, b] = math.sqrt(err)
+                    position_error[n, b] = err
                     orientation_error[n, b] = branch_orientation_error(
                         prm, target, g, mode, pitch[n], q, pose
                     )

@@ -12,6 +12,7 @@ import math
 import numba
 import numpy as np
 
+from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
 from lynxplan.robots.ik.family_geometry import (
@@ -78,6 +79,21 @@ def lu_solve(lu: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
         x[i] = total / lu[i, i]
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def reached_approach(prm: np.ndarray, pose: np.ndarray) -> tuple[float, float, float]:
+    """The approach axis of a reached pose (4, 4), in the base frame: R (Rt0^T r)."""
+    rt = prm[F.RT0 : F.RT0 + 9]
+    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
+    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2  # the approach in the tool frame: Rt0^T r
+    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
+    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
+    return (
+        pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2,
+        pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2,
+        pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2,
+    )
+
+
 @numba.njit(cache=True, nogil=True)
 def conditions(
     problem: ChainProblem,
@@ -94,15 +110,7 @@ def conditions(
     for i in range(3):
         e[i] = pose[i, 3] - target[i, 3]
     # approach axis and pitch axis of the reached configuration
-    rt = prm[F.RT0 : F.RT0 + 9]
-    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
-    # approach in the tool frame: Rt0^T r
-    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
-    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
-    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
-    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
-    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
-    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+    a0, a1, a2 = reached_approach(prm, pose)
     cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
     k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
     pp0, pp1, pp2 = rotate(k0, k1, k2, cy, sy, prm[F.P], prm[F.P + 1], prm[F.P + 2])
@@ -205,6 +213,76 @@ def polish(
 
 
 @numba.njit(cache=True, nogil=True)
+def rotation_angle(target: np.ndarray, pose: np.ndarray) -> float:
+    """Angle of the rotation from target[:3, :3] to pose[:3, :3] [rad], accurate near 0."""
+    tr = 0.0
+    for i in range(3):
+        tr += target[0, i] * pose[0, i] + target[1, i] * pose[1, i] + target[2, i] * pose[2, i]
+    # vee of (Rt^T R - R^T Rt): rows of Rt^T R are columns of Rt dotted with columns of R
+    m01 = m10 = m02 = m20 = m12 = m21 = 0.0
+    for r in range(3):
+        m01 += target[r, 0] * pose[r, 1]
+        m10 += target[r, 1] * pose[r, 0]
+        m02 += target[r, 0] * pose[r, 2]
+        m20 += target[r, 2] * pose[r, 0]
+        m12 += target[r, 1] * pose[r, 2]
+        m21 += target[r, 2] * pose[r, 1]
+    s0, s1, s2 = m21 - m12, m02 - m20, m10 - m01
+    return math.atan2(0.5 * math.sqrt(s0 * s0 + s1 * s1 + s2 * s2), 0.5 * (tr - 1.0))
+
+
+@numba.njit(cache=True, nogil=True)
+def axis_angle(a0: float, a1: float, a2: float, t0: float, t1: float, t2: float) -> float:
+    """Angle between the unit axes a and t [rad] (atan2 of |a x t| and a . t)."""
+    c0, c1, c2 = a1 * t2 - a2 * t1, a2 * t0 - a0 * t2, a0 * t1 - a1 * t0
+    return math.atan2(math.sqrt(c0 * c0 + c1 * c1 + c2 * c2), a0 * t0 + a1 * t1 + a2 * t2)
+
+
+@numba.njit(cache=True, nogil=True)
+def settle(
+    placements: np.ndarray,
+    axes: np.ndarray,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    tol: float,
+    target: np.ndarray,
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+) -> tuple[bool, float]:
+    """A branch's angles q (5,) wrapped into the limits in place (snapping within tol); its
+    pose on the exact chain into pose (4, 4) (work: scratch). Returns (within the limits,
+    position error against target [m])."""
+    inside = True
+    for j in range(5):
+        x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)
+        q[j] = x
+        inside = inside and ok
+    chain_fk(placements, axes, q, pose, work)
+    err = 0.0
+    for i in range(3):
+        d = pose[i, 3] - target[i, 3]
+        err += d * d
+    return inside, math.sqrt(err)
+
+
+@numba.njit(cache=True, nogil=True)
+def is_duplicate(
+    branches: np.ndarray, taken: np.ndarray, count: int, q: np.ndarray, tolerance: float
+) -> bool:
+    """Whether q (5,) is within tolerance [rad] in every joint of one of branches[:count]
+    (rows: angles first) whose ``taken`` flag is set (bool, or float 1/0)."""
+    for b in range(count):
+        if taken[b]:
+            gap = 0.0
+            for j in range(5):
+                gap = max(gap, abs(branches[b, j] - q[j]))
+            if gap < tolerance:
+                return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True)
 def branch_orientation_error(
     prm: np.ndarray,
     target: np.ndarray,
@@ -216,29 +294,8 @@ def branch_orientation_error(
 ) -> float:
     """Angle between target and reached orientation (pose) or approach axes (approach, pitch)."""
     if mode == MODE_POSE:
-        s0 = s1 = s2 = 0.0
-        tr = 0.0
-        for i in range(3):
-            tr += target[0, i] * pose[0, i] + target[1, i] * pose[1, i] + target[2, i] * pose[2, i]
-        # vee of (Rt^T R - R^T Rt): rows of Rt^T R are columns of Rt dotted with columns of R
-        m01 = m10 = m02 = m20 = m12 = m21 = 0.0
-        for r in range(3):
-            m01 += target[r, 0] * pose[r, 1]
-            m10 += target[r, 1] * pose[r, 0]
-            m02 += target[r, 0] * pose[r, 2]
-            m20 += target[r, 2] * pose[r, 0]
-            m12 += target[r, 1] * pose[r, 2]
-            m21 += target[r, 2] * pose[r, 1]
-        s0, s1, s2 = m21 - m12, m02 - m20, m10 - m01
-        return math.atan2(0.5 * math.sqrt(s0 * s0 + s1 * s1 + s2 * s2), 0.5 * (tr - 1.0))
-    rt = prm[F.RT0 : F.RT0 + 9]
-    r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
-    u0 = rt[0] * r0 + rt[3] * r1 + rt[6] * r2
-    u1 = rt[1] * r0 + rt[4] * r1 + rt[7] * r2
-    u2 = rt[2] * r0 + rt[5] * r1 + rt[8] * r2
-    a0 = pose[0, 0] * u0 + pose[0, 1] * u1 + pose[0, 2] * u2
-    a1 = pose[1, 0] * u0 + pose[1, 1] * u1 + pose[1, 2] * u2
-    a2 = pose[2, 0] * u0 + pose[2, 1] * u1 + pose[2, 2] * u2
+        return rotation_angle(target, pose)
+    a0, a1, a2 = reached_approach(prm, pose)
     if mode == MODE_PITCH:
         k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
         cy, sy = math.cos(prm[F.SIGMA] * q[0]), math.sin(prm[F.SIGMA] * q[0])
@@ -247,5 +304,4 @@ def branch_orientation_error(
         t0, t1, t2 = sp * h0 - cp * k0, sp * h1 - cp * k1, sp * h2 - cp * k2
     else:
         t0, t1, t2 = g[0, 3], g[1, 3], g[2, 3]
-    c0, c1, c2 = a1 * t2 - a2 * t1, a2 * t0 - a0 * t2, a0 * t1 - a1 * t0
-    return math.atan2(math.sqrt(c0 * c0 + c1 * c1 + c2 * c2), a0 * t0 + a1 * t1 + a2 * t2)
+    return axis_angle(a0, a1, a2, t0, t1, t2)

@@ -1,4 +1,5 @@
-"""Python side of the yaw-pitch-pitch-pitch-roll solver: packing, AL5 delegation, results."""
+"""Python side of the yaw-pitch-pitch-pitch-roll solver: kernel calls, the near-axis rescue,
+the single-pose path, results (the AL5 delegation: ``al5_bridge``)."""
 
 from __future__ import annotations
 
@@ -9,7 +10,8 @@ import numpy as np
 
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
-from lynxplan.robots.results import RobotIkBatch, RobotIkResult
+from lynxplan.robots.ik.al5_bridge import al5_fill
+from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
 if TYPE_CHECKING:
@@ -48,23 +50,15 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
     assert family is not None
     n = target.poses.shape[0]
     slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
-    # the kernel writes every slot of the targets it solves (NaN / False where no branch)
-    q = np.empty((n, slots, 5))
-    valid = np.empty((n, slots), dtype=np.bool_)
-    within = np.empty((n, slots), dtype=np.bool_)
-    perr, oerr = np.empty((n, slots)), np.empty((n, slots))
+    out = BranchSlots.empty(n, slots)
     rest = None
     if robot._arm is not None and target.kind != fk_.MODE_PITCH:
-        q.fill(np.nan)
-        valid.fill(False)
-        within.fill(False)
-        perr.fill(np.nan)
-        oerr.fill(np.nan)
-        rest = ~_al5_fill(robot, target, reference, q, valid, within, perr, oerr)
+        out.clear()
+        rest = ~al5_fill(robot, target, reference, out)
     elif target.kind == fk_.MODE_POSE:
-        rest = ~_pose_fill(robot, target, reference, q, valid, within, perr, oerr)
+        rest = ~_pose_fill(robot, target, reference, out)
     if rest is None or rest.all():
-        _kernel(robot, target, reference, q, valid, within, perr, oerr)
+        _kernel(robot, target, reference, out)
     elif rest.any():
         sub = type(target)(
             np.ascontiguousarray(target.poses[rest]),
@@ -73,11 +67,11 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
             target.roll[rest],
         )
         ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[rest])
-        parts = [a[rest] for a in (q, valid, within, perr, oerr)]
-        _kernel(robot, sub, ref, *parts)
-        for whole, part in zip((q, valid, within, perr, oerr), parts, strict=True):
-            whole[rest] = part
-    rescue_near_axis(robot, target, q, valid, within, perr, oerr)
+        part = out.rows(rest)
+        _kernel(robot, sub, ref, part)
+        out.put(rest, part)
+    rescue_near_axis(robot, target, out)
+    q, valid, within, perr, oerr = out
     distance = np.where(valid, perr, np.inf).min(axis=1)
     reachable = distance <= REACH_TOLERANCE
     # a reachable target's solutions are the branches that reach it; the others are dropped
@@ -98,15 +92,7 @@ RESCUE_SEED = 5
 ROLL_NUDGES = (-0.8, -0.4, -0.2, -0.1, 0.1, 0.2, 0.4, 0.8)
 
 
-def rescue_near_axis(
-    robot: Robot,
-    target: Target,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    perr: np.ndarray,
-    oerr: np.ndarray,
-) -> None:
+def rescue_near_axis(robot: Robot, target: Target, out: BranchSlots) -> None:
     """Near-family models (off-axis tool): Levenberg-Marquardt on the exact chain adds the
     branches the ideal model misses. Full poses near the yaw axis with no exact branch: from
     each branch and fixed random starts. Approach targets with the roll free and no exact
@@ -116,6 +102,7 @@ def rescue_near_axis(
     """
     from lynxplan.robots.ik.numerical import numerical_ik_kernel
 
+    q, valid, within, perr, oerr = out
     family = robot.family
     assert family is not None
     if family.exact or family.tool_on_roll_axis or target.kind == fk_.MODE_PITCH:
@@ -185,19 +172,10 @@ def rescue_near_axis(
             perr[row, slot], oerr[row, slot] = p_err[i], o_err[i]
 
 
-def _kernel(
-    robot: Robot,
-    target: Target,
-    reference: np.ndarray,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    perr: np.ndarray,
-    oerr: np.ndarray,
-) -> None:
+def _kernel(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> None:
     family = robot.family
     assert family is not None
-    miss = np.empty(valid.shape)
+    miss = np.empty(out.valid.shape)
     fk_.family_ik_kernel(
         family.packed,
         robot.chain.placements,
@@ -207,11 +185,7 @@ def _kernel(
         target.pitch,
         target.roll,
         reference,
-        q,
-        valid,
-        within,
-        perr,
-        oerr,
+        *out,
         miss,
     )
 
@@ -248,16 +222,7 @@ def solve_pose_one(
     )
 
 
-def _pose_fill(
-    robot: Robot,
-    target: Target,
-    reference: np.ndarray,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    perr: np.ndarray,
-    oerr: np.ndarray,
-) -> np.ndarray:
+def _pose_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> np.ndarray:
     """Full poses the orientation solves in closed form (``pose_kernel``); returns which. The
     others (out of reach, degenerate, a given roll) need the general kernel (root search)."""
     family = robot.family
@@ -269,57 +234,8 @@ def _pose_fill(
         robot.chain.axes,
         target.poses,
         reference,
-        q,
-        valid,
-        within,
-        perr,
-        oerr,
+        *out,
         solved,
     )
     solved &= np.isnan(target.roll)
     return solved
-
-
-def _al5_fill(
-    robot: Robot,
-    target: Target,
-    reference: np.ndarray,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    perr: np.ndarray,
-    oerr: np.ndarray,
-) -> np.ndarray:
-    """Targets the AL5 kernels of lynxplan.arm solve (same numbers as before); returns which."""
-    from lynxplan.arm.ik import IkStatus
-
-    ref = np.broadcast_to(reference, (target.poses.shape[0], 5)).copy()
-    given = ~np.isnan(target.roll)
-    ref[given, 4] = target.roll[given]
-    arm = robot._arm
-    batch = arm.ik_batch(
-        target.poses, q_reference=ref, approach_only=target.kind == fk_.MODE_APPROACH
-    )
-    ok: np.ndarray = np.asarray(np.asarray(batch.status) == IkStatus.OK)
-    if not ok.any():
-        return ok
-    valid[ok] = True
-    q_arm = np.asarray(batch.q)[ok]
-    poses = np.asarray(arm.fk(q_arm.reshape(-1, 5))).reshape(-1, 4, 4, 4)
-    goal = target.poses[ok]
-    q[ok] = q_arm
-    within[ok] = np.asarray(batch.within_limits)[ok]
-    perr[ok] = np.linalg.norm(poses[:, :, :3, 3] - goal[:, None, :3, 3], axis=2)
-    if target.kind == fk_.MODE_APPROACH:
-        cosine = np.einsum("nbi,ni->nb", poses[:, :, :3, 2], goal[:, :3, 2])
-        sine = np.linalg.norm(np.cross(poses[:, :, :3, 2], goal[:, None, :3, 2]), axis=2)
-        oerr[ok] = np.arctan2(sine, cosine)
-    else:
-        m = np.einsum("nji,nbjk->nbik", goal[:, :3, :3], poses[:, :, :3, :3])
-        trace = np.trace(m, axis1=2, axis2=3)
-        vee = np.stack(
-            (m[..., 2, 1] - m[..., 1, 2], m[..., 0, 2] - m[..., 2, 0], m[..., 1, 0] - m[..., 0, 1]),
-            axis=-1,
-        )
-        oerr[ok] = np.arctan2(0.5 * np.linalg.norm(vee, axis=-1), 0.5 * (trace - 1.0))
-    return ok

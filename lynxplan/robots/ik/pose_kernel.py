@@ -23,11 +23,17 @@ import math
 import numba
 import numpy as np
 
-from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
-from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
+from lynxplan.robots.chain import chain_fk_jacobian
 from lynxplan.robots.ik.family_geometry import MODE_POSE, best_roll, branch, pitch_sum, wrap, yaw
-from lynxplan.robots.ik.family_polish import branch_orientation_error, lu_factor, lu_solve
+from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
+from lynxplan.robots.ik.family_polish import (
+    is_duplicate,
+    lu_factor,
+    lu_solve,
+    rotation_angle,
+    settle,
+)
 
 #: A branch reaches a full pose exactly within this position [m] and orientation [rad] error.
 POSE_EXACT = 1e-9
@@ -191,28 +197,11 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                     continue
                 if not exact_model:
                     polish_pose(placements, axes, target, q, pose, work, jac, origins, normal)
-                inside = True
-                for j in range(5):
-                    x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)
-                    q[j] = x
-                    inside = inside and ok
-                chain_fk(placements, axes, q, pose, work)
-                err = 0.0
-                for i in range(3):
-                    e = pose[i, 3] - target[i, 3]
-                    err += e * e
-                err = math.sqrt(err)
-                angle = branch_orientation_error(prm, target, g, MODE_POSE, 0.0, q, pose)
+                inside, err = settle(placements, axes, lower, upper, tol, target, q, pose, work)
+                angle = rotation_angle(target, pose)
                 if not (err <= POSE_EXACT and angle <= POSE_EXACT):
                     continue
-                duplicate = False
-                for b2 in range(nb):
-                    if out[b2, VALID] != 0.0:
-                        gap = 0.0
-                        for j in range(5):
-                            gap = max(gap, abs(out[b2, j] - q[j]))
-                        duplicate = duplicate or gap < 1e-9
-                if duplicate:
+                if is_duplicate(out, out[:, VALID], nb, q, DUPLICATE_TOLERANCE):
                     continue
                 for j in range(5):
                     out[b, j] = q[j]
