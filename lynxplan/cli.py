@@ -68,6 +68,23 @@ COMMAND_MODULES = (
     "lynxplan.commands.robots",
 )
 
+#: The module that registers each sub-command: ``lynxplan CMD ...`` builds the parsers of CMD's
+#: module only (building all of them took ~8 ms of every start-up); ``lynxplan --help`` and an
+#: unknown command build them all. tests/cli checks this table against the modules.
+COMMAND_OF: dict[str, str] = {
+    "fk": "lynxplan.commands.arm",
+    "ik": "lynxplan.commands.arm",
+    "workspace": "lynxplan.commands.workspace",
+    "run": "lynxplan.commands.run",
+    "bench": "lynxplan.commands.bench",
+    "parallel": "lynxplan.commands.parallel",
+    "schema": "lynxplan.commands.scenario_tools",
+    "validate": "lynxplan.commands.scenario_tools",
+    "serve": "lynxplan.commands.serve",
+    "robots": "lynxplan.commands.robots",
+    "robot": "lynxplan.commands.robots",
+}
+
 
 class _Parser(argparse.ArgumentParser):
     """ArgumentParser whose usage errors are one line and exit code 2, and which takes every
@@ -106,8 +123,9 @@ def _epilog() -> str:
     return "\n".join(lines)
 
 
-def build_parser() -> argparse.ArgumentParser:
-    """The full ``lynxplan`` parser with every sub-command registered."""
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
+    """The ``lynxplan`` parser: every sub-command registered, or (``command`` named in
+    :data:`COMMAND_OF`) only the sub-commands of that command's module."""
     parser = _Parser(
         prog="lynxplan",
         description="Modelling and planning for a 5-DOF arm and a planar 3-RRR parallel robot.",
@@ -128,7 +146,8 @@ def build_parser() -> argparse.ArgumentParser:
     )
     subparsers = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=_Parser)
     subparsers.required = True
-    for name in COMMAND_MODULES:
+    modules = (COMMAND_OF[command],) if command in COMMAND_OF else COMMAND_MODULES
+    for name in modules:
         importlib.import_module(name).register(subparsers)
     return parser
 
@@ -208,7 +227,8 @@ def _main(argv: Sequence[str]) -> int:
     try:
         args_list, debug, max_samples = _split_global(argv)
         try:
-            args = build_parser().parse_args(args_list)
+            command = args_list[0] if args_list and not args_list[0].startswith("-") else None
+            args = build_parser(command).parse_args(args_list)
         except SystemExit as exc:  # --help, --version, usage errors (already printed)
             return exc.code if isinstance(exc.code, int) else EXIT_BAD_INPUT
         limit = None if max_samples is None else _max_samples(max_samples)

@@ -6,13 +6,17 @@ heavy imports off the paths that do not need them.
 
 from __future__ import annotations
 
+import argparse
 import gc
+import importlib
 import subprocess
 import sys
 from importlib.metadata import version
 from pathlib import Path
 
-from lynxplan.cli import GC_THRESHOLD, main
+import pytest
+
+from lynxplan.cli import COMMAND_MODULES, COMMAND_OF, GC_THRESHOLD, build_parser, main
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -55,3 +59,35 @@ def test_a_call_with_arguments_leaves_the_garbage_collector_alone(capsys) -> Non
     threshold, frozen = gc.get_threshold(), gc.get_freeze_count()
     assert main(["--version"]) == 0
     assert (gc.get_threshold(), gc.get_freeze_count()) == (threshold, frozen)
+
+
+def _registered(modules: tuple[str, ...]) -> dict[str, str]:
+    """Sub-command name -> the module whose ``register`` adds it."""
+    found = {}
+    for name in modules:
+        subparsers = argparse.ArgumentParser().add_subparsers()
+        importlib.import_module(name).register(subparsers)
+        found |= dict.fromkeys(subparsers.choices, name)
+    return found
+
+
+def test_the_command_table_names_the_module_of_every_sub_command() -> None:
+    assert _registered(COMMAND_MODULES) == COMMAND_OF
+
+
+def test_a_command_builds_only_its_module_s_parsers(capsys) -> None:
+    parser = build_parser("fk")
+    assert parser.parse_args(["ik", "--position", "0.2", "0.1", "0.3"]).command == "ik"
+    with pytest.raises(SystemExit):
+        parser.parse_args(["run", "scenario.yaml"])
+    assert "invalid choice: 'run'" in capsys.readouterr().err
+    assert build_parser(None).parse_args(["run", "scenario.yaml"]).command == "run"
+
+
+def test_help_and_unknown_commands_list_every_command(capsys) -> None:
+    assert main(["--help"]) == 0
+    out = capsys.readouterr().out
+    assert all(name in out for name in COMMAND_OF)
+    assert main(["frobnicate"]) == 2
+    err = capsys.readouterr().err
+    assert "invalid choice: 'frobnicate'" in err and "robots" in err
