@@ -29,6 +29,27 @@ def as_array(x: Any, name: str, shape_tail: tuple[int, ...]) -> np.ndarray:
     return array.reshape((-1, *shape_tail))
 
 
+#: Rotation blocks further than this from orthonormal are re-orthonormalised (up to the guards'
+#: repair tolerance; beyond it they are refused).
+ORTHONORMAL_TOLERANCE = 1e-12
+
+
+def _rigid_poses(poses: Any) -> np.ndarray:
+    """Full target poses (N, 4, 4): checked by ``lynxplan.guards.poses`` (finite, in range,
+    last row 0 0 0 1, rotation within the repair tolerance of proper orthonormal), then
+    rotation blocks off orthonormal replaced by the nearest rotation (polar decomposition)."""
+    from lynxplan.guards import poses as checked_poses
+
+    array = np.array(checked_poses("pose", poses), dtype=float).reshape(-1, 4, 4)
+    rotations = array[:, :3, :3]
+    gram = np.einsum("nji,njk->nik", rotations, rotations) - np.eye(3)
+    off = np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOLERANCE
+    if off.any():
+        u, _, vt = np.linalg.svd(rotations[off])
+        array[off, :3, :3] = u @ vt
+    return array
+
+
 def make_target(  # noqa: PLR0912 (one branch per target form)
     poses: Any = None,
     positions: Any = None,
@@ -40,7 +61,7 @@ def make_target(  # noqa: PLR0912 (one branch per target form)
     if poses is not None:
         if positions is not None or approaches is not None or pitches is not None:
             raise TargetError("give a pose, or a position with an approach or a pitch; not both")
-        array = as_array(poses, "pose", (4, 4))
+        array = _rigid_poses(poses)
         kind = KIND_POSE
         n = array.shape[0]
     else:

@@ -137,3 +137,28 @@ def test_al5_single_pose_path_matches_the_batch() -> None:
             [s.q for s in one.solutions], [s.q for s in other.solutions], atol=0
         )
         assert one.distance == pytest.approx(other.distance, abs=1e-15)
+
+
+@pytest.mark.parametrize("name", ["so101", "al5"])
+def test_full_pose_targets_must_be_rigid(name: str) -> None:
+    """A scaled rotation or a wrong last row is refused with the guards' error (single and
+    batch, naming the pose); a rotation a little off orthonormal is repaired, then solved."""
+    from lynxplan.exceptions import NonFiniteInputError, NotRigidTransformError
+
+    robot = load_robot(name)
+    pose = robot.fk(robot.random_configurations(1, seed=21)[0])
+    scaled = pose.copy()
+    scaled[:3, :3] *= 2.0
+    bottom = pose.copy()
+    bottom[3] = [0.0, 0.0, 0.1, 1.0]
+    for bad in (scaled, bottom):
+        with pytest.raises(NotRigidTransformError):
+            robot.ik(bad)
+        with pytest.raises(NotRigidTransformError, match=r"pose\[1\]"):
+            robot.ik_batch(np.stack((pose, bad)))
+    with pytest.raises(NonFiniteInputError):
+        robot.ik(np.where(np.eye(4, dtype=bool), np.nan, pose))
+    nudged = pose.copy()
+    nudged[0, 0] += 1e-7  # within the repair tolerance: the nearest rotation is solved
+    result = robot.ik(nudged)
+    assert result.solutions and result.orientation_residual < 1e-6

@@ -213,6 +213,27 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
     return solved
 
 
+#: A rotation block this close to orthonormal (and the last row to 0 0 0 1) is taken as it is.
+RIGID_TOLERANCE = 1e-12
+
+
+@numba.njit(cache=True, nogil=True)
+def _is_rigid(pose: np.ndarray) -> bool:
+    """Whether pose (4, 4) is finite with a rotation block orthonormal to RIGID_TOLERANCE and
+    the last row 0 0 0 1 (NaN fails every comparison)."""
+    for j in range(4):
+        if not math.isfinite(pose[3, j]) or not math.isfinite(pose[0, j] + pose[1, j] + pose[2, j]):
+            return False
+    if abs(pose[3, 0]) + abs(pose[3, 1]) + abs(pose[3, 2]) + abs(pose[3, 3] - 1.0) > 0.0:
+        return False
+    for i in range(3):
+        for j in range(i, 3):
+            dot = pose[0, i] * pose[0, j] + pose[1, i] * pose[1, j] + pose[2, i] * pose[2, j]
+            if not abs(dot - (1.0 if i == j else 0.0)) <= RIGID_TOLERANCE:
+                return False
+    return True
+
+
 #: Columns of ``pose_one``'s compact table: q (5), then these.
 SLOT, COMPACT_WITHIN, COMPACT_POSITION_ERROR, COMPACT_ORIENTATION_ERROR = 5, 6, 7, 8
 
@@ -232,7 +253,11 @@ def pose_one(
     Returns the number k of exact branches (0: not solved here), written to compact[:k]
     (rows: q (5) [rad], slot index, within limits 1/0, position error [m], orientation error
     [rad]); compact has shape (slots, SLOT_COLUMNS).
+    Poses that are not finite, not rigid (last row 0 0 0 1, rotation orthonormal to
+    RIGID_TOLERANCE) return 0: the general path checks and repairs them.
     """
+    if not _is_rigid(target):
+        return 0
     out = np.empty((slots, SLOT_COLUMNS))
     solved = solve_target(
         prm,
