@@ -55,16 +55,19 @@ def test_the_process_entry_tunes_the_garbage_collector(monkeypatch, capsys) -> N
     assert capsys.readouterr().out.startswith("lynxplan ")
 
 
-def test_the_service_keeps_python_s_collector_settings(monkeypatch, capsys) -> None:
+@pytest.mark.parametrize("command", ["serve", "bench"])
+def test_long_running_commands_keep_python_s_collector_settings(
+    monkeypatch, capsys, command: str
+) -> None:
     threshold = gc.get_threshold()
-    monkeypatch.setattr(sys, "argv", ["lynxplan", "--debug", "serve", "--help"])
+    monkeypatch.setattr(sys, "argv", ["lynxplan", "--debug", command, "--help"])
     try:
         assert main() == 0
         assert gc.get_threshold() == threshold
     finally:
         gc.unfreeze()
         gc.set_threshold(*threshold)
-    assert "usage: lynxplan serve" in capsys.readouterr().out
+    assert f"usage: lynxplan {command}" in capsys.readouterr().out
 
 
 def test_a_call_with_arguments_leaves_the_garbage_collector_alone(capsys) -> None:
