@@ -155,7 +155,25 @@ class Robot:
     # -- geometry models -----------------------------------------------------------------------
     @cached_property
     def collision_model(self) -> Any:
-        """Pinocchio GeometryModel of the URDF's collision elements (meshes via package_dirs)."""
+        """Pinocchio GeometryModel of the collision geometry lynxplan checks: the URDF's
+        collision elements, meshes as their convex hulls (hull files cached on disk, see
+        :mod:`lynxplan.robots.hull_cache`; the originals: :attr:`collision_mesh_model`)."""
+        import pinocchio as pin
+
+        from lynxplan.robots.hull_cache import hull_urdf
+
+        dirs = self._mesh_dirs()
+        return pin.buildGeomFromUrdfString(
+            self.model,
+            hull_urdf(self._urdf_xml, self.urdf_path.parent, dirs),
+            pin.GeometryType.COLLISION,
+            package_dirs=list(dirs),
+        )
+
+    @cached_property
+    def collision_mesh_model(self) -> Any:
+        """Pinocchio GeometryModel of the URDF's collision elements as written (original
+        meshes via package_dirs)."""
         import pinocchio as pin
 
         return pin.buildGeomFromUrdfString(

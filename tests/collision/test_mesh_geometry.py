@@ -29,7 +29,7 @@ def world():
 def _mesh_distance(robot, q: np.ndarray, geometry: int, box) -> float:
     """coal's distance from the original (non-convex) mesh to a box obstacle."""
     data = robot.model.createData()
-    collision = robot.collision_model
+    collision = robot.collision_mesh_model
     geometry_data = pin.GeometryData(collision)
     pin.forwardKinematics(robot.model, data, q)
     pin.updateGeometryPlacements(robot.model, data, collision, geometry_data)

@@ -64,14 +64,14 @@ def test_clearance_is_exact_on_hulls_and_safe_for_the_meshes(run) -> None:
 
     robot = run.setup.arm
     k = int(np.argmin(np.abs(samples.t - worst.time)))
-    data, geometry_data = robot.model.createData(), pin.GeometryData(robot.collision_model)
+    data, geometry_data = robot.model.createData(), pin.GeometryData(robot.collision_mesh_model)
     pin.forwardKinematics(robot.model, data, samples.q[k])
-    pin.updateGeometryPlacements(robot.model, data, robot.collision_model, geometry_data)
-    names = [g.name for g in robot.collision_model.geometryObjects]
+    pin.updateGeometryPlacements(robot.model, data, robot.collision_mesh_model, geometry_data)
+    names = [g.name for g in robot.collision_mesh_model.geometryObjects]
     obstacle = next(o for o in run.setup.obstacles if o.name == worst.obstacle)
     mesh_pose = geometry_data.oMg[names.index(worst.geometry)]
     mesh_distance = coal.distance(
-        robot.collision_model.geometryObjects[names.index(worst.geometry)].geometry,
+        robot.collision_mesh_model.geometryObjects[names.index(worst.geometry)].geometry,
         coal.Transform3s(mesh_pose.rotation, mesh_pose.translation),
         coal.Box(*obstacle.size),
         coal.Transform3s(np.eye(3), obstacle.centre),
