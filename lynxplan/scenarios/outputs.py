@@ -168,9 +168,10 @@ def csv_rows(table: np.ndarray) -> str:
     """The rows of ``table`` (N, m) as CSV lines, each value in its shortest exact decimal form.
 
     Every number reads back to the same float (``float(text) == value``, the repr rule), so a
-    reloaded trajectory equals the in-memory one bit for bit. orjson formats the numbers (about
-    20 times faster than ``numpy.savetxt``; it writes ``1e-5``, ``1e+20``, ``0.0``); a table
-    holding NaN or infinity, which JSON cannot carry, is written with ``repr`` (``nan``, ``inf``).
+    reloaded trajectory equals the in-memory one bit for bit. orjson formats the numbers (26,001
+    rows of 19 values in ~35 ms; ``numpy.savetxt`` took ~220 ms for a 15-digit format that does
+    not round-trip); it writes ``1e-5``, ``1e+20``, ``0.0``. A table holding NaN or infinity,
+    which JSON cannot carry, is written with ``repr`` (``nan``, ``inf``).
     """
     values = np.ascontiguousarray(table, dtype=np.float64)
     if values.ndim != 2:
