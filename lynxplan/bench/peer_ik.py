@@ -14,6 +14,7 @@ import json
 import sys
 import time
 from importlib import metadata
+from typing import Any
 
 import numpy as np
 
@@ -59,16 +60,12 @@ def run_pink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
 
 def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     """placo's KinematicsSolver (QP, soft frame task, joint limits), iterated to convergence."""
-    import re
     import tempfile
 
     import placo
 
-    # IK needs no geometry, and placo cannot resolve package:// mesh URIs: drop the shapes
-    with open(urdf) as handle:
-        text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
     with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as stripped:
-        stripped.write(text)
+        stripped.write(_urdf_without_shapes(urdf))
     robot = placo.RobotWrapper(stripped.name, placo.Flags.ignore_collisions)
     solver = placo.KinematicsSolver(robot)
     solver.mask_fbase(True)
@@ -88,6 +85,64 @@ def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list
                 break
         times.append(time.perf_counter() - start)
         ok.append(_ok(robot.get_T_world_frame(tool), target))
+    return ok, times
+
+
+def _urdf_without_shapes(urdf: str) -> str:
+    """The URDF's text without <visual>/<collision>: IK needs no geometry, and the peers cannot
+    resolve ``package://`` mesh URIs."""
+    import re
+
+    with open(urdf) as handle:
+        return re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
+
+
+def _mujoco_model(urdf: str) -> Any:
+    """The URDF through MuJoCo's URDF compiler, every link kept as a body.
+
+    The compiler fuses links on fixed joints into their parents by default (``fusestatic``),
+    which removes tool links such as ``gripper_frame_link``: a ``<mujoco><compiler/>``
+    element turns that off. Links without inertia get a tiny bound (IK ignores mass).
+    """
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+
+    root = ET.fromstring(_urdf_without_shapes(urdf))
+    extension = root.find("mujoco")
+    if extension is None:
+        extension = ET.SubElement(root, "mujoco")
+    compiler = extension.find("compiler")
+    if compiler is None:
+        compiler = ET.SubElement(extension, "compiler")
+    compiler.set("fusestatic", "false")
+    compiler.set("boundmass", "1e-6")
+    compiler.set("boundinertia", "1e-9")
+    return mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+
+
+def run_mink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
+    """mink's differential IK (FrameTask on the tool link's body, daqp, configuration limits),
+    integrated like pink's; the reached pose is MuJoCo's FK of that body."""
+    import mink
+
+    model = _mujoco_model(urdf)
+    configuration = mink.Configuration(model)
+    task = mink.FrameTask(tool, "body", position_cost=1.0, orientation_cost=1.0)
+    zero = np.zeros(model.nq)
+    ok, times = [], []
+    for target in poses:
+        configuration.update(zero)
+        task.set_target(mink.SE3.from_matrix(target))
+        start = time.perf_counter()
+        for _ in range(200):
+            velocity = mink.solve_ik(configuration, [task], 0.05, solver="daqp")
+            configuration.integrate_inplace(velocity, 0.05)
+            reached = configuration.get_transform_frame_to_world(tool, "body").as_matrix()
+            if _ok(reached, target):
+                break
+        times.append(time.perf_counter() - start)
+        ok.append(_ok(configuration.get_transform_frame_to_world(tool, "body").as_matrix(), target))
     return ok, times
 
 
@@ -126,9 +181,9 @@ def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
 def main() -> None:
     peer, urdf, tool, poses_path, out = sys.argv[1:6]
     poses = np.load(poses_path)
-    runner = {"pink": run_pink, "ikpy": run_ikpy, "placo": run_placo}[peer]
+    runner = {"pink": run_pink, "ikpy": run_ikpy, "placo": run_placo, "mink": run_mink}[peer]
     ok, times = runner(urdf, tool, poses)
-    package = {"pink": "pin-pink", "ikpy": "ikpy", "placo": "placo"}[peer]
+    package = {"pink": "pin-pink", "ikpy": "ikpy", "placo": "placo", "mink": "mink"}[peer]
     with open(out, "w") as handle:
         json.dump(
             {
