@@ -146,20 +146,31 @@ def run_mink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
     return ok, times
 
 
-def _root_link(urdf: str) -> str:
-    """The URDF's root link: the one link that is no joint's child."""
+def _path_to(urdf: str, tool: str) -> list[str]:
+    """The URDF elements from the root link to the link ``tool``: link, joint, link, ... tool.
+
+    ikpy follows the first child joint of a link where the path is not given, which on a link
+    with two children (a gripper with a jaw and a tool link) may miss the tool."""
     import xml.etree.ElementTree as ET
 
     tree = ET.parse(urdf).getroot()
-    children = {c.get("link") for c in tree.iter("child")}
-    roots = [link.get("name") for link in tree.iter("link") if link.get("name") not in children]
-    return str(roots[0]) if roots else "base_link"
+    parent_joint = {
+        child.get("link"): joint
+        for joint in tree.iter("joint")
+        if (child := joint.find("child")) is not None
+    }
+    path = [tool]
+    while path[0] in parent_joint:
+        joint = parent_joint[path[0]]
+        parent = joint.find("parent")
+        path[:0] = [str(parent.get("link") if parent is not None else ""), str(joint.get("name"))]
+    return path
 
 
 def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     from ikpy.chain import Chain
 
-    base = [_root_link(urdf)]
+    base = _path_to(urdf, tool)
     chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=base)
     names = [link.name for link in chain.links]
     mask = [link.joint_type != "fixed" for link in chain.links]
