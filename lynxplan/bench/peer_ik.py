@@ -4,8 +4,9 @@
 
 Solves each pose (N, 4, 4) from the zero configuration with the peer and writes
 ``{"peer", "version", "success", "median_us", "count"}``. A solve succeeds when the reached tool
-pose is within 1e-6 m and 1e-5 rad of the target (checked with Pinocchio, or with the peer's own
-FK where Pinocchio is absent). Imports nothing from lynxplan: the peer venvs do not have it.
+pose is within 1e-6 m and 1e-5 rad of the target, by the peer's own FK: Pinocchio's for pink and
+placo, ikpy's, MuJoCo's for mink (ikpy's and MuJoCo's agree with lynxplan's FK of SO-100/101 to
+1e-15). Imports nothing from lynxplan: the peer venvs do not have it.
 """
 
 from __future__ import annotations
