@@ -32,10 +32,18 @@ NUMERICAL_TRIPS, NUMERICAL_QUICK_TRIPS = 2_000, 200
 FULL_PEER_POSES, QUICK_PEER_POSES = 1_000, 50
 
 
+def _warm_up(robot: object) -> None:
+    """Solve a few poses first: a kernel's first call may compile it or load it from numba's
+    cache, which is not the throughput measured."""
+    q = robot.random_configurations(8, seed=99)  # type: ignore[attr-defined]
+    robot.ik_batch(robot.fk(q))  # type: ignore[attr-defined]
+
+
 def _round_trips(robot: object, count: int, seed: int) -> tuple[float, float, float]:
     """(success fraction, worst position error [m], seconds per pose) over ``count`` trips."""
     chunk = 50_000
     solved, worst, seconds = 0, 0.0, 0.0
+    _warm_up(robot)
     for start in range(0, count, chunk):
         q = robot.random_configurations(min(chunk, count - start), seed=seed + start)  # type: ignore[attr-defined]
         poses = robot.fk(q)  # type: ignore[attr-defined]
@@ -217,6 +225,7 @@ def _verified_solves(robot: Robot, count: int, seed: int) -> tuple[float, float,
     """(fraction reached exactly, worst position error [m], seconds per pose) of the IK of
     ``count`` FK poses of random configurations (a numerical solver need not return the start)."""
     poses = robot.fk(robot.random_configurations(count, seed=seed))
+    _warm_up(robot)
     begin = time.thread_time()
     batch = robot.ik_batch(poses)
     seconds = time.thread_time() - begin
@@ -232,6 +241,7 @@ def _comparison(robot: Robot, quick: bool) -> list[Figure]:
     name = robot.name
     count = QUICK_PEER_POSES if quick else FULL_PEER_POSES
     poses = robot.fk(robot.random_configurations(count, seed=3))
+    _warm_up(robot)
     begin = time.thread_time()
     batch = robot.ik_batch(poses)
     ours = (time.thread_time() - begin) / count
