@@ -6,7 +6,8 @@ dropped for the children, as an installed package has its ``.pyc`` files): ``lyn
 ``lynxplan run scenarios/ok_task.yaml --quick`` and, as the yardstick of the machine,
 ``python -c 'import pinocchio'``. Figures are medians of wall time and of the child's CPU time
 (user + system, less sensitive to a shared machine), and each command's ratio to the pinocchio
-import.
+import. Run from a source tree, the children import that tree's lynxplan (``PYTHONPATH``), so a
+worktree measures its own code, not an editable install's.
 """
 
 from __future__ import annotations
@@ -26,7 +27,8 @@ SECTION = "cold"
 #: The issue's goals, in [s] of wall time on the CI machine.
 TARGET_FK_SECONDS = 0.5
 TARGET_RUN_SECONDS = 1.5
-_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "ok_task.yaml"
+_SOURCE_ROOT = Path(__file__).resolve().parents[2]  # the folder holding this lynxplan package
+_SCENARIO = _SOURCE_ROOT / "scenarios" / "ok_task.yaml"
 _CLI = "import sys; from lynxplan.cli import main; sys.exit(main())"
 
 
@@ -50,6 +52,12 @@ def time_command(command: list[str]) -> tuple[float, float]:
         RuntimeError: the command failed (its last stderr line is quoted).
     """
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    if (_SOURCE_ROOT / "pyproject.toml").is_file():
+        # Run from a source tree (a checkout, a worktree): the children import this lynxplan,
+        # not whichever one their working directory or an editable install would give them.
+        env["PYTHONPATH"] = os.pathsep.join(
+            filter(None, [str(_SOURCE_ROOT), env.get("PYTHONPATH")])
+        )
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, check=False, env=env)

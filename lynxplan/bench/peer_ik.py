@@ -4,8 +4,9 @@
 
 Solves each pose (N, 4, 4) from the zero configuration with the peer and writes
 ``{"peer", "version", "success", "median_us", "count"}``. A solve succeeds when the reached tool
-pose is within 1e-6 m and 1e-5 rad of the target (checked with Pinocchio, or with the peer's own
-FK where Pinocchio is absent). Imports nothing from lynxplan: the peer venvs do not have it.
+pose is within 1e-6 m and 1e-5 rad of the target, by the peer's own FK: Pinocchio's for pink and
+placo, ikpy's, MuJoCo's for mink (ikpy's and MuJoCo's agree with lynxplan's FK of SO-100/101 to
+1e-15). Imports nothing from lynxplan: the peer venvs do not have it.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ import json
 import sys
 import time
 from importlib import metadata
+from typing import Any
 
 import numpy as np
 
@@ -59,16 +61,12 @@ def run_pink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
 
 def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     """placo's KinematicsSolver (QP, soft frame task, joint limits), iterated to convergence."""
-    import re
     import tempfile
 
     import placo
 
-    # IK needs no geometry, and placo cannot resolve package:// mesh URIs: drop the shapes
-    with open(urdf) as handle:
-        text = re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
     with tempfile.NamedTemporaryFile("w", suffix=".urdf", delete=False) as stripped:
-        stripped.write(text)
+        stripped.write(_urdf_without_shapes(urdf))
     robot = placo.RobotWrapper(stripped.name, placo.Flags.ignore_collisions)
     solver = placo.KinematicsSolver(robot)
     solver.mask_fbase(True)
@@ -91,20 +89,89 @@ def run_placo(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list
     return ok, times
 
 
-def _root_link(urdf: str) -> str:
-    """The URDF's root link: the one link that is no joint's child."""
+def _urdf_without_shapes(urdf: str) -> str:
+    """The URDF's text without <visual>/<collision>: IK needs no geometry, and the peers cannot
+    resolve ``package://`` mesh URIs."""
+    import re
+
+    with open(urdf) as handle:
+        return re.sub(r"<(visual|collision)\b.*?</\1>", "", handle.read(), flags=re.S)
+
+
+def _mujoco_model(urdf: str) -> Any:
+    """The URDF through MuJoCo's URDF compiler, every link kept as a body.
+
+    The compiler fuses links on fixed joints into their parents by default (``fusestatic``),
+    which removes tool links such as ``gripper_frame_link``: a ``<mujoco><compiler/>``
+    element turns that off. Links without inertia get a tiny bound (IK ignores mass).
+    """
+    import xml.etree.ElementTree as ET
+
+    import mujoco
+
+    root = ET.fromstring(_urdf_without_shapes(urdf))
+    extension = root.find("mujoco")
+    if extension is None:
+        extension = ET.SubElement(root, "mujoco")
+    compiler = extension.find("compiler")
+    if compiler is None:
+        compiler = ET.SubElement(extension, "compiler")
+    compiler.set("fusestatic", "false")
+    compiler.set("boundmass", "1e-6")
+    compiler.set("boundinertia", "1e-9")
+    return mujoco.MjModel.from_xml_string(ET.tostring(root, encoding="unicode"))
+
+
+def run_mink(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
+    """mink's differential IK (FrameTask on the tool link's body, daqp, configuration limits),
+    integrated like pink's; the reached pose is MuJoCo's FK of that body."""
+    import mink
+
+    model = _mujoco_model(urdf)
+    configuration = mink.Configuration(model)
+    task = mink.FrameTask(tool, "body", position_cost=1.0, orientation_cost=1.0)
+    zero = np.zeros(model.nq)
+    ok, times = [], []
+    for target in poses:
+        configuration.update(zero)
+        task.set_target(mink.SE3.from_matrix(target))
+        start = time.perf_counter()
+        for _ in range(200):
+            velocity = mink.solve_ik(configuration, [task], 0.05, solver="daqp")
+            configuration.integrate_inplace(velocity, 0.05)
+            reached = configuration.get_transform_frame_to_world(tool, "body").as_matrix()
+            if _ok(reached, target):
+                break
+        times.append(time.perf_counter() - start)
+        ok.append(_ok(configuration.get_transform_frame_to_world(tool, "body").as_matrix(), target))
+    return ok, times
+
+
+def _path_to(urdf: str, tool: str) -> list[str]:
+    """The URDF elements from the root link to the link ``tool``: link, joint, link, ... tool.
+
+    ikpy follows the first child joint of a link where the path is not given, which on a link
+    with two children (a gripper with a jaw and a tool link) may miss the tool."""
     import xml.etree.ElementTree as ET
 
     tree = ET.parse(urdf).getroot()
-    children = {c.get("link") for c in tree.iter("child")}
-    roots = [link.get("name") for link in tree.iter("link") if link.get("name") not in children]
-    return str(roots[0]) if roots else "base_link"
+    parent_joint = {
+        child.get("link"): joint
+        for joint in tree.iter("joint")
+        if (child := joint.find("child")) is not None
+    }
+    path = [tool]
+    while path[0] in parent_joint:
+        joint = parent_joint[path[0]]
+        parent = joint.find("parent")
+        path[:0] = [str(parent.get("link") if parent is not None else ""), str(joint.get("name"))]
+    return path
 
 
 def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[float]]:
     from ikpy.chain import Chain
 
-    base = [_root_link(urdf)]
+    base = _path_to(urdf, tool)
     chain = Chain.from_urdf_file(urdf, last_link_vector=None, base_elements=base)
     names = [link.name for link in chain.links]
     mask = [link.joint_type != "fixed" for link in chain.links]
@@ -126,9 +193,9 @@ def run_ikpy(urdf: str, tool: str, poses: np.ndarray) -> tuple[list[bool], list[
 def main() -> None:
     peer, urdf, tool, poses_path, out = sys.argv[1:6]
     poses = np.load(poses_path)
-    runner = {"pink": run_pink, "ikpy": run_ikpy, "placo": run_placo}[peer]
+    runner = {"pink": run_pink, "ikpy": run_ikpy, "placo": run_placo, "mink": run_mink}[peer]
     ok, times = runner(urdf, tool, poses)
-    package = {"pink": "pin-pink", "ikpy": "ikpy", "placo": "placo"}[peer]
+    package = {"pink": "pin-pink", "ikpy": "ikpy", "placo": "placo", "mink": "mink"}[peer]
     with open(out, "w") as handle:
         json.dump(
             {

@@ -32,10 +32,20 @@ NUMERICAL_TRIPS, NUMERICAL_QUICK_TRIPS = 2_000, 200
 FULL_PEER_POSES, QUICK_PEER_POSES = 1_000, 50
 
 
+def _warm_up(robot: object) -> None:
+    """Solve a few poses first: a kernel's first call may compile it or load it from numba's
+    cache, which is not the throughput measured."""
+    q = robot.random_configurations(8, seed=99)  # type: ignore[attr-defined]
+    poses = robot.fk(q)  # type: ignore[attr-defined]
+    poses[0, :3, 3] *= 5.0  # out of reach: the general kernel too
+    robot.ik_batch(poses)  # type: ignore[attr-defined]
+
+
 def _round_trips(robot: object, count: int, seed: int) -> tuple[float, float, float]:
     """(success fraction, worst position error [m], seconds per pose) over ``count`` trips."""
     chunk = 50_000
     solved, worst, seconds = 0, 0.0, 0.0
+    _warm_up(robot)
     for start in range(0, count, chunk):
         q = robot.random_configurations(min(chunk, count - start), seed=seed + start)  # type: ignore[attr-defined]
         poses = robot.fk(q)  # type: ignore[attr-defined]
@@ -51,9 +61,69 @@ def _round_trips(robot: object, count: int, seed: int) -> tuple[float, float, fl
     return solved / count, worst, seconds / count
 
 
-#: Peers run in their own virtual environments: PEERS_DIR/<peer>/bin/python (placo, pink, ikpy;
-#: placo 0.10 needs pin 3.8, which conflicts with lynxplan's pin 4).
+#: Peers run in their own virtual environments: PEERS_DIR/<peer>/bin/python (placo, pink, mink,
+#: ikpy; placo 0.10 needs pin 3.8, which conflicts with lynxplan's pin 4).
 PEERS_DIR = os.environ.get("LYNXPLAN_PEERS_DIR", "/work/peers")
+#: The peers, in the order of the table.
+PEERS = ("placo", "pink", "mink", "ikpy")
+
+
+def urdf_with_tool(robot: Robot) -> str | None:
+    """The robot's URDF text with its tool frame added as a link, or None where it has one.
+
+    A tool frame lynxplan defines itself (the SO-100's, between the jaws) or one named after a
+    joint is no URDF link, so the peers cannot target it. The added link hangs on a fixed joint
+    from the child link of the tool's parent joint: that link's frame is the joint's frame, in
+    which Pinocchio places the tool (``frame.placement``). A base given to ``load_robot`` is not
+    written.
+    """
+    import xml.etree.ElementTree as ET
+
+    import pinocchio as pin
+
+    root = ET.fromstring(robot.urdf_path.read_text())
+    if any(link.get("name") == robot.tool_frame for link in root.iter("link")):
+        return None
+    frame = robot.model.frames[robot.tool_frame_id]
+    parent_joint = str(robot.model.names[int(frame.parentJoint)])
+    child_links = {
+        joint.get("name"): child.get("link")
+        for joint in root.iter("joint")
+        if (child := joint.find("child")) is not None
+    }
+    parent_link = child_links.get(parent_joint)
+    if parent_link is None:  # the tool is on the base: the root link's frame is the world's
+        children = set(child_links.values())
+        parent_link = next(
+            str(link.get("name")) for link in root.iter("link") if link.get("name") not in children
+        )
+    joints = {joint.get("name") for joint in root.iter("joint")}
+    joint_name = f"{robot.tool_frame}_joint"
+    while joint_name in joints:
+        joint_name += "_"
+    placement = frame.placement
+    ET.SubElement(root, "link", name=robot.tool_frame)
+    joint = ET.SubElement(root, "joint", name=joint_name, type="fixed")
+    ET.SubElement(joint, "parent", link=str(parent_link))
+    ET.SubElement(joint, "child", link=robot.tool_frame)
+    ET.SubElement(
+        joint,
+        "origin",
+        xyz=" ".join(repr(float(v)) for v in placement.translation),
+        rpy=" ".join(repr(float(v)) for v in pin.rpy.matrixToRpy(placement.rotation)),
+    )
+    return ET.tostring(root, encoding="unicode")
+
+
+def _peer_urdf(robot: Robot, folder: Path) -> Path:
+    """A URDF of ``robot`` with its tool frame as a link: its own, or a copy written to
+    ``folder``."""
+    text = urdf_with_tool(robot)
+    if text is None:
+        return robot.urdf_path
+    path = folder / f"{robot.urdf_path.stem}_{robot.tool_frame}.urdf"
+    path.write_text(text)
+    return path
 
 
 def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
@@ -63,7 +133,8 @@ def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
     with tempfile.TemporaryDirectory() as folder:
         poses_path = Path(folder) / "poses.npy"
         np.save(poses_path, poses)
-        for peer in ("placo", "pink", "ikpy"):
+        urdf = _peer_urdf(robot, Path(folder))
+        for peer in PEERS:
             python = Path(PEERS_DIR) / peer / "bin" / "python"
             if not python.is_file():
                 continue
@@ -72,7 +143,7 @@ def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
                 str(python),
                 str(script),
                 peer,
-                str(robot.urdf_path),
+                str(urdf),
                 robot.tool_frame,
                 str(poses_path),
                 str(out),
@@ -156,6 +227,7 @@ def _verified_solves(robot: Robot, count: int, seed: int) -> tuple[float, float,
     """(fraction reached exactly, worst position error [m], seconds per pose) of the IK of
     ``count`` FK poses of random configurations (a numerical solver need not return the start)."""
     poses = robot.fk(robot.random_configurations(count, seed=seed))
+    _warm_up(robot)
     begin = time.thread_time()
     batch = robot.ik_batch(poses)
     seconds = time.thread_time() - begin
@@ -171,6 +243,7 @@ def _comparison(robot: Robot, quick: bool) -> list[Figure]:
     name = robot.name
     count = QUICK_PEER_POSES if quick else FULL_PEER_POSES
     poses = robot.fk(robot.random_configurations(count, seed=3))
+    _warm_up(robot)
     begin = time.thread_time()
     batch = robot.ik_batch(poses)
     ours = (time.thread_time() - begin) / count

@@ -17,6 +17,7 @@ import os
 import tempfile
 import xml.etree.ElementTree as ET
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -113,3 +114,14 @@ def hull_urdf(urdf_xml: str, urdf_dir: Path | None, package_dirs: tuple[str, ...
                 mesh.set("filename", str(hull))
                 changed = True
     return ET.tostring(root, encoding="unicode") if changed else urdf_xml
+
+
+def geometry_model(robot: Any, kind: str, *, hulls: bool) -> Any:
+    """Pinocchio GeometryModel of a Robot's URDF elements of ``kind`` ("collision" or
+    "visual"); with ``hulls``, collision meshes replaced by their cached hull files."""
+    import pinocchio as pin
+
+    dirs = robot._mesh_dirs()
+    xml = hull_urdf(robot._urdf_xml, robot.urdf_path.parent, dirs) if hulls else robot._urdf_xml
+    geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
+    return pin.buildGeomFromUrdfString(robot.model, xml, geometry_type, package_dirs=list(dirs))

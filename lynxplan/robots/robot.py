@@ -28,6 +28,7 @@ from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import ShapeError, TargetError
 from lynxplan.robots import chain as _chain
 from lynxplan.robots.family import FamilyParameters, recognise_family
+from lynxplan.robots.hull_cache import geometry_model
 from lynxplan.robots.loading import BuiltinRobot, LoadedModel
 from lynxplan.robots.results import JointInfo, RobotIkBatch, RobotIkResult, RobotInfo, TrackResult
 from lynxplan.robots.selection import REACH_TOLERANCE, TRACK_JUMP_THRESHOLD, select_one, track
@@ -56,12 +57,6 @@ __all__ = [
 def _family_solver() -> ModuleType:
     """The family solver module, imported on first use (it loads the numba kernels)."""
     return importlib.import_module("lynxplan.robots.ik.family_solver")
-
-
-@functools.cache
-def _al5_bridge() -> ModuleType:
-    """The AL5 delegation module, imported on first use (it loads the numba kernels)."""
-    return importlib.import_module("lynxplan.robots.ik.al5_bridge")
 
 
 class Robot:
@@ -158,42 +153,17 @@ class Robot:
         """Pinocchio GeometryModel of the collision geometry lynxplan checks: the URDF's
         collision elements, meshes as their convex hulls (hull files cached on disk, see
         :mod:`lynxplan.robots.hull_cache`; the originals: :attr:`collision_mesh_model`)."""
-        import pinocchio as pin
-
-        from lynxplan.robots.hull_cache import hull_urdf
-
-        dirs = self._mesh_dirs()
-        return pin.buildGeomFromUrdfString(
-            self.model,
-            hull_urdf(self._urdf_xml, self.urdf_path.parent, dirs),
-            pin.GeometryType.COLLISION,
-            package_dirs=list(dirs),
-        )
+        return geometry_model(self, "collision", hulls=True)
 
     @cached_property
     def collision_mesh_model(self) -> Any:
-        """Pinocchio GeometryModel of the URDF's collision elements as written (original
-        meshes via package_dirs)."""
-        import pinocchio as pin
-
-        return pin.buildGeomFromUrdfString(
-            self.model,
-            self._urdf_xml,
-            pin.GeometryType.COLLISION,
-            package_dirs=list(self._mesh_dirs()),
-        )
+        """Pinocchio GeometryModel of the URDF's collision elements as written."""
+        return geometry_model(self, "collision", hulls=False)
 
     @cached_property
     def visual_model(self) -> Any:
         """Pinocchio GeometryModel of the URDF's visual elements."""
-        import pinocchio as pin
-
-        return pin.buildGeomFromUrdfString(
-            self.model,
-            self._urdf_xml,
-            pin.GeometryType.VISUAL,
-            package_dirs=list(self._mesh_dirs()),
-        )
+        return geometry_model(self, "visual", hulls=False)
 
     def _mesh_dirs(self) -> tuple[str, ...]:
         return (*self.package_dirs, str(self.urdf_path.parent))
@@ -347,12 +317,8 @@ class Robot:
             and self.family is not None
         ):
             # the lean paths; a pose they cannot solve (NaN/inf, out of reach) goes on below
-            reference = self._reference(q_reference, 1)
-            frame = np.ascontiguousarray(pose, dtype=float)
-            one: RobotIkResult | None = (
-                _family_solver().solve_pose_one(self, frame, reference[0], verify)
-                if self._arm is None
-                else _al5_bridge().solve_al5_pose_one(self, frame, reference[0], verify)
+            one: RobotIkResult | None = _family_solver().solve_pose_one(
+                self, pose, self._reference(q_reference, 1)[0], verify
             )
             if one is not None:
                 return one

@@ -103,7 +103,9 @@ class Al5Kinematics:
     def tool_poses(self, q: np.ndarray) -> np.ndarray:
         from lynxplan.arm.kinematics import forward_kinematics
 
-        return forward_kinematics(q, self.geometry)
+        # Always a writable array: read-only and writable inputs are two signatures of the
+        # compiled kernel, each one more load from numba's cache in a fresh process (~4 ms).
+        return forward_kinematics(np.array(q, dtype=float), self.geometry)
 
     def pitch(self, pose: np.ndarray, q: np.ndarray) -> float:
         """The approach's angle in the vertical plane through the tool point of ``pose``."""

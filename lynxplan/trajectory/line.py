@@ -193,6 +193,13 @@ def _solve_line(
     return ik.q, ik.branch, ik.residual
 
 
+def _check_mode(mode: str) -> None:
+    if mode not in ORIENTATION_MODES:
+        raise InputError(
+            f"unknown orientation mode {mode!r}; valid modes: {', '.join(ORIENTATION_MODES)}"
+        )
+
+
 def line_segment(
     T_start: np.ndarray,
     T_end: np.ndarray,
@@ -218,14 +225,35 @@ def line_segment(
         InputError: unknown mode, or ``T_start`` far from the FK of ``q_start``.
         PathNotFollowableError: the line leaves the arm's reach.
     """
-    if mode not in ORIENTATION_MODES:
-        raise InputError(
-            f"unknown orientation mode {mode!r}; valid modes: {', '.join(ORIENTATION_MODES)}"
-        )
+    _check_mode(mode)
+    T0 = guards.poses("T_start", T_start, batch=False)
+    T1 = guards.poses("T_end", T_end, batch=False)
+    return line_segment_from_checked_poses(
+        T0, T1, q_start, timing, mode=mode, limits=limits, kinematics=kinematics
+    )
+
+
+def line_segment_from_checked_poses(
+    T_start: np.ndarray,
+    T_end: np.ndarray,
+    q_start: np.ndarray | list[float],
+    timing: LspbTiming | None = None,
+    *,
+    mode: str = "consistent",
+    limits: MotionLimits | None = None,
+    kinematics: PathKinematics | None = None,
+) -> LineSegment:
+    """:func:`line_segment` of poses that are known to be rigid transforms within range: the FK
+    of configurations, or poses the caller has checked (:func:`lynxplan.guards.poses`).
+
+    The rest is checked as by :func:`line_segment`: the mode, the start configuration, the
+    timing, the distance of ``T_start`` from the FK of ``q_start``.
+    """
+    _check_mode(mode)
     lim = limits or MotionLimits()
     kin = kinematics or Al5Kinematics()
-    T0 = guards.poses("T_start", T_start, batch=False).copy()
-    T1 = guards.poses("T_end", T_end, batch=False).copy()
+    T0 = np.array(T_start, dtype=float)
+    T1 = np.array(T_end, dtype=float)
     qs = as_configuration(q_start, "q_start")
     check_timing(timing)
     gap = float(np.linalg.norm(kin.tool_poses(qs[None])[0, :3, 3] - T0[:3, 3]))

@@ -26,7 +26,7 @@ from lynxplan.trajectory.free import (
 )
 from lynxplan.trajectory.kinematics import Al5Kinematics, PathKinematics
 from lynxplan.trajectory.limits import MotionLimits
-from lynxplan.trajectory.line import LineSegment, line_segment
+from lynxplan.trajectory.line import LineSegment, line_segment_from_checked_poses
 from lynxplan.trajectory.lspb import LspbTiming
 
 Segment = FreeSegment | LineSegment
@@ -167,7 +167,8 @@ def _build_segment(
             target_q = as_configuration(spec.target_q, f"segments[{i}].target_q")
             pose = kinematics.tool_poses(target_q[None])[0]
         T_start = kinematics.tool_poses(q[None])[0]
-        return line_segment(
+        # Both poses are FK results or were checked above: not checked again (numba kernel).
+        return line_segment_from_checked_poses(
             T_start, pose, q, spec.timing, mode=spec.mode, limits=lim, kinematics=kinematics
         )
     raise InputError(f"segment {i}: unknown kind {spec.kind!r}; valid kinds: free, line")

@@ -128,11 +128,12 @@ def test_trajectory_csv_reloads_to_the_in_memory_trajectory(name, tmp_path):
     table = np.loadtxt(tmp_path / "trajectory.csv", delimiter=",", skiprows=1)
     samples = output.payload.samples if name == "ok_task" else output.payload[1]
     assert table.shape == (len(samples.t), 19)
-    np.testing.assert_allclose(table[:, 0], samples.t, rtol=1e-14, atol=1e-15)
-    np.testing.assert_allclose(table[:, 1:6], samples.q, rtol=1e-14, atol=1e-15)
-    np.testing.assert_allclose(table[:, 6:11], samples.qd, rtol=1e-14, atol=1e-15)
-    np.testing.assert_allclose(table[:, 11:16], samples.qdd, rtol=1e-14, atol=1e-14)
-    np.testing.assert_allclose(table[:, 16:], samples.tool[:, :3, 3], rtol=1e-14, atol=1e-15)
+    # The values are written in their shortest exact form: they read back bit for bit.
+    np.testing.assert_array_equal(table[:, 0], samples.t)
+    np.testing.assert_array_equal(table[:, 1:6], samples.q)
+    np.testing.assert_array_equal(table[:, 6:11], samples.qd)
+    np.testing.assert_array_equal(table[:, 11:16], samples.qdd)
+    np.testing.assert_array_equal(table[:, 16:], samples.tool[:, :3, 3])
 
 
 def test_a_quick_run_replaces_the_whole_folder(tmp_path):

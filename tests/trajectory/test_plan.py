@@ -11,6 +11,7 @@ from lynxplan.trajectory import (
     LspbTiming,
     SegmentSpec,
     build_plan,
+    line_segment,
     ok_task_configurations,
     ok_task_plan,
     segment_reports,
@@ -103,3 +104,20 @@ def test_errors(ok_plan) -> None:
     far[:3, 3] = [0, 2.0, 0]
     with pytest.raises(PathNotFollowableError, match=r"segment 0 \(free\) leaves the arm.s reach"):
         build_plan(q[0], [SegmentSpec("free", target_pose=far)])
+
+
+def test_line_targets_are_checked_once() -> None:
+    # A line's poses are FK results or the caller's checked pose: the plan builds the same
+    # segment as line_segment, which checks them, and still rejects a bad mode or pose.
+    q = ok_task_configurations()
+    plan = build_plan(q[0], [SegmentSpec("line", target_q=q[1], timing=LspbTiming(2.0, 0.5))])
+    direct = line_segment(
+        forward_kinematics(q[0]), forward_kinematics(q[1]), q[0], LspbTiming(2.0, 0.5)
+    )
+    np.testing.assert_array_equal(plan.segments[0].grid.q, direct.grid.q)
+    with pytest.raises(InputError, match="unknown orientation mode 'spline'"):
+        build_plan(q[0], [SegmentSpec("line", target_q=q[1], mode="spline")])
+    skewed = forward_kinematics(q[1])
+    skewed[:3, :3] *= 1.1
+    with pytest.raises(InputError, match=r"target_pose"):
+        build_plan(q[0], [SegmentSpec("line", target_pose=skewed)])

@@ -4,13 +4,13 @@ the single-pose path, results (the AL5 delegation: ``al5_bridge``)."""
 from __future__ import annotations
 
 import functools
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
-from lynxplan.robots.ik.al5_bridge import al5_fill
+from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
@@ -191,11 +191,14 @@ def _kernel(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlot
 
 
 def solve_pose_one(
-    robot: Robot, pose: np.ndarray, reference: np.ndarray, verify: bool
+    robot: Robot, pose: Any, reference: np.ndarray, verify: bool
 ) -> RobotIkResult | None:
     """One full pose (4, 4) with the roll free, the lean way (one kernel call, no batch
-    arrays): the result, or None where the pose needs the general path (not reached exactly by
-    the orientation's closed form: out of reach or degenerate). ``reference`` (n,) [rad]."""
+    arrays; the AL5 through ``Arm.ik``): the result, or None where the pose needs the general
+    path (not finite or rigid, out of reach, degenerate). ``reference`` (n,) [rad]."""
+    pose = np.ascontiguousarray(pose, dtype=float)
+    if robot._arm is not None:
+        return solve_al5_pose_one(robot, pose, reference, verify)
     family = robot.family
     assert family is not None
     slots = 4 if family.tool_on_roll_axis else 4 * fk_.MAX_ROOTS

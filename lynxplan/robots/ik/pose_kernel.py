@@ -1,4 +1,5 @@
-"""Numba kernel: full poses of an off-axis tool in closed form, before any root search.
+"""Numba kernel: full poses of a yaw-pitch-pitch-pitch-roll arm in closed form, before any
+root search (needed by an off-axis tool point, whose roll the position does not fix).
 
 A full target pose fixes the orientation, and the orientation of a yaw-pitch-pitch-pitch-roll
 arm fixes its yaw, pitch sum and roll up to one flip: the yaw puts the approach axis in the arm
@@ -8,8 +9,8 @@ wrist link and the branch is closed-form (``family_geometry.branch``: two elbows
 *solved here* when one of these branches reaches the pose exactly on the exact chain
 (position and orientation to :data:`POSE_EXACT`); every exact branch of the pose has this
 orientation, so no other branch exists. Targets not solved here (the pose is out of reach, so
-the nearest orientation is wanted; the approach along the yaw axis; a target near the yaw axis
-of a near-family model) go to the roll root search of ``family_kernel``.
+the nearest orientation is wanted; the approach along the yaw axis, which leaves the yaw to the
+position) go to the general kernel (``family_kernel``: the roll root search of an off-axis tool).
 
 Slots are those of the kernel's layouts, so one batch has one layout: ``side * 2 + elbow``
 (tool on the roll axis: each flip is one side) or ``side * per_side + 2 * flip + elbow`` (the
@@ -71,7 +72,7 @@ def polish_pose(
     nearly identical ideal model (~1e-6 away): position error [m] and the rotation vector
     vee(R Rt^T - Rt R^T) / 2 [rad] against the geometric Jacobian (6, 5). The target is reachable
     exactly (zero residual), so it converges quadratically (linearly next to a fold of the
-    elbow); stops when the error stops falling by MIN_FALL.
+    elbow); stops when the error stops falling by MIN_FALL (a step that made it worse undone).
 
     Scratch: pose, work (4, 4); jac (6, 5); origins (5, 6); normal (7, 5): J^T J, its LU row
     order, and J^T e.
@@ -79,6 +80,7 @@ def polish_pose(
     previous = math.inf
     e = np.empty(6)
     step = np.empty(5)
+    before = q.copy()
     for _ in range(NEWTON_STEPS):
         chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
         for i in range(3):
@@ -97,8 +99,11 @@ def polish_pose(
         for i in range(6):
             size = max(size, abs(e[i]))
         if size < NEWTON_TOLERANCE or not size * MIN_FALL <= previous:
+            if not size <= previous:  # the last step made it worse: undo it
+                q[:] = before
             return
         previous = size
+        before[:] = q
         for i in range(5):
             total = 0.0
             for k in range(6):
