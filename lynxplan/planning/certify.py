@@ -35,17 +35,14 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.planning.edge_walk import STEP_GROWTH, lever_arms, reach_step, span_motion
 from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
 from lynxplan.planning.validity import (
-    STEP_GROWTH,
     centre_gap,
     joint_poses,
-    lever_arms,
     pair_bound,
     primitive_pose,
     primitive_poses,
-    reach_step,
-    span_motion,
 )
 
 #: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.

@@ -7,7 +7,7 @@ gives one root per collision-free IK branch). Each iteration, in the compiled ke
    of the other tree instead);
 2. *extend* the active tree: from its nearest node (linear scan, Euclidean) one step of at most
    ``step`` [rad] towards the sample; the edge is certified by the validity checker's
-   conservative advancement (:func:`lynxplan.planning.validity.edge_fraction`);
+   conservative advancement (:func:`lynxplan.planning.edge_walk.edge_fraction`);
 3. *connect* the other tree to the new node: the straight edge from its nearest node is walked
    as far as it is certified; nodes are added every ``step`` along it; reaching the new node
    joins the trees;
@@ -34,15 +34,8 @@ import numpy as np
 
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.validity import (
-    ValidityChecker,
-    edge_fraction_from,
-    edge_is_free,
-    pair_bound,
-    point_is_clear,
-    primitive_poses,
-    state_slacks,
-)
+from lynxplan.planning.edge_walk import edge_fraction_from, edge_is_free, state_slacks
+from lynxplan.planning.validity import ValidityChecker, pair_bound, point_is_clear, primitive_poses
 
 #: Kernel status codes.
 RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2

@@ -25,7 +25,8 @@ import numba
 import numpy as np
 
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.validity import ValidityChecker, edge_is_free, point_is_clear
+from lynxplan.planning.edge_walk import edge_is_free
+from lynxplan.planning.validity import ValidityChecker, point_is_clear
 
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60

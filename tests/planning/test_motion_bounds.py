@@ -8,13 +8,8 @@ import pytest
 
 from lynxplan.arm import Arm
 from lynxplan.collision import BoxObstacle, CollisionWorld
-from lynxplan.planning.validity import (
-    ValidityChecker,
-    lever_arms,
-    primitive_poses,
-    reach_step,
-    span_motion,
-)
+from lynxplan.planning.edge_walk import lever_arms, reach_step, span_motion
+from lynxplan.planning.validity import ValidityChecker, primitive_poses
 
 #: Dense samples of each tested interval.
 SAMPLES = 60

@@ -1,0 +1,283 @@
+"""Conservative advancement along an edge of joint space for the planner's checker (numba).
+
+Between two states ``q_a`` and ``q_b`` the joints move linearly. A point at distance ``rho_j`` from
+joint j's axis moves at ``sum_j rho_j |dq_j|`` per unit of the edge parameter ``s`` (proof in
+:mod:`lynxplan.collision.check`, with ``rho_j`` bounded by the static reach ``R_gj``). The walk
+uses the lever arms at the configuration itself (:func:`lever_arms`: the distance of the
+primitive's centre from each axis plus its bounding radius), which grow at most at the point's own
+speed relative to that joint (:func:`reach_step`, :func:`span_motion`). For a self pair only the
+joints that move one body and not the other count (the distance depends on the relative pose only;
+common ancestors move both rigidly), and a fixed cylinder coaxial with the first joint (the base)
+makes that joint irrelevant (:func:`lynxplan.planning.kernel_model.pair_rates`). A pair with slack
+``sigma`` above the clearance at ``s`` is certified one-sided up to ``s + ds`` (its motion bound
+reaches ``sigma``), and two-sided on ``[s, t]`` when ``sigma_s + sigma_t`` exceeds the motion bound
+over it. The pair certified least far advances next; the walk stops where a bound comes within
+:data:`STALL_DISTANCE` of the clearance. Every certified part of an edge is collision-free for the
+real geometry with distance >= ``clearance``: no sampling resolution, nothing skipped between
+samples.
+
+Primitives fixed to the base (joint 0) do not move: their obstacle pairs are checked once,
+exactly, by the problem set-up, and left out here.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba
+import numpy as np
+
+from lynxplan.planning.validity import (
+    STALL_DISTANCE,
+    joint_poses_upto,
+    pair_bound,
+    primitive_pose,
+    primitive_poses,
+)
+
+
+@numba.njit(cache=True, inline="always")
+def lever_arms(p: int, world: np.ndarray, poses: np.ndarray, model: Any, out: np.ndarray) -> None:
+    """Lever arm of pair p about each joint at joint poses ``world`` (J, 4, 4) and primitive
+    poses ``poses`` (G, 4, 4) -> out (nq,), in [m]: the largest distance of a point of the
+    primitive that joint j moves (relative to the other side) from joint j's axis, bounded by
+    the distance of its centre from the axis plus its bounding radius; 0 when j moves neither.
+    """
+    axes, radius, owners, joints = model[0], model[7], model[15], model[16]
+    for j in range(out.shape[0]):
+        g = owners[p, j]
+        joint = joints[j]
+        if g < 0 or joint < 0:
+            out[j] = 0.0
+            continue
+        a = axes[joint]
+        w0, w1, w2 = world[joint, 0, a], world[joint, 1, a], world[joint, 2, a]
+        d0 = poses[g, 0, 3] - world[joint, 0, 3]
+        d1 = poses[g, 1, 3] - world[joint, 1, 3]
+        d2 = poses[g, 2, 3] - world[joint, 2, 3]
+        c0, c1, c2 = w1 * d2 - w2 * d1, w2 * d0 - w0 * d2, w0 * d1 - w1 * d0
+        out[j] = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) + radius[g]
+
+
+@numba.njit(cache=True, inline="always")
+def reach_step(slack: float, p: int, arms: np.ndarray, model: Any, scratch: Any) -> float:
+    """Largest ds such that pair p, with ``slack`` [m] above the clearance at s and lever arms
+    ``arms`` (nq,) there, provably keeps the clearance on [s, s + ds] (one-sided).
+
+    A point of the moving primitive moves at most ``sum_j |dq_j| rho_j`` per unit s, rho_j its
+    distance from joint j's axis; rho_j at s is at most ``arms[j]``, never more than the static
+    reach ``R_j`` (``model[9]``), and grows at most at the speed of the point relative to joint
+    j's frame, ``L = sum_i R_i |dq_i|`` (only joints between j and the primitive move it there).
+    So the motion over ds is at most ``min(L ds, V ds + L D ds^2 / 2)`` with ``V = sum_j |dq_j|
+    min(R_j, arms_j)`` and ``D = sum_j |dq_j|`` over the pair's joints.
+    """
+    rates, dq = model[9], scratch[14]
+    static = lever = spread = 0.0
+    for j in range(dq.shape[0]):
+        if rates[p, j] > 0.0:
+            static += rates[p, j] * dq[j]
+            lever += min(rates[p, j], arms[j]) * dq[j]
+            spread += dq[j]
+    if static <= 0.0:
+        return np.inf
+    quadratic = 2.0 * slack / (lever + math.sqrt(lever * lever + 2.0 * static * spread * slack))
+    return max(slack / static, quadratic)
+
+
+@numba.njit(cache=True, inline="always")
+def span_motion(p: int, ds: float, model: Any, scratch: Any) -> float:
+    """Bound of pair p's motion over an interval of length ds (of s) between two points whose
+    lever arms are scratch[13][0] and scratch[13][1], in [m].
+
+    In between, rho_j is at most the smaller of ``rho_j(s) + L (u - s)`` and ``rho_j(t) +
+    L (t - u)``, hence at most their mean ``(rho_j(s) + rho_j(t) + L ds) / 2``, and at most R_j.
+    """
+    rates, dq, arms = model[9], scratch[14], scratch[13]
+    static = 0.0
+    for j in range(dq.shape[0]):
+        static += rates[p, j] * dq[j]
+    total = 0.0
+    for j in range(dq.shape[0]):
+        if rates[p, j] > 0.0:
+            rho = 0.5 * (min(rates[p, j], arms[0, j]) + min(rates[p, j], arms[1, j]) + static * ds)
+            total += min(rates[p, j], rho) * dq[j]
+    return total * ds
+
+
+@numba.njit(cache=True, inline="always")
+def _pair_at(
+    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
+) -> float:
+    """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
+    q, pairs, joint_of = scratch[7], model[8], model[4]
+    for j in range(q_a.shape[0]):
+        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
+    last = joint_of[pairs[p, 0]]
+    if pairs[p, 2] == 1:
+        last = max(last, joint_of[pairs[p, 1]])
+    joint_poses_upto(q, model, scratch, last)
+    primitive_pose(pairs[p, 0], model, scratch)
+    if pairs[p, 2] == 1:
+        primitive_pose(pairs[p, 1], model, scratch)
+    scratch[9][1] += 1
+    scratch[9][2] += 1
+    lever_arms(p, scratch[0], scratch[3], model, scratch[13][side])
+    return float(pair_bound(p, model, scratch))
+
+
+#: A walk tries a two-sided step of this many one-sided steps (the two-sided test allows < 2).
+STEP_GROWTH = 1.9
+#: ... and never more than this many.
+MAX_GROWTH = 4.0
+
+
+@numba.njit(cache=True)
+def state_slacks(
+    q: np.ndarray, model: Any, scratch: Any, clearance: float, out: np.ndarray
+) -> bool:
+    """Every pair's bound minus the clearance at q (nq,) -> out (P,), in [m]; whether all exceed
+    :data:`STALL_DISTANCE`. Stops at the first pair that does not (out is then partial), trying
+    first the pair that failed last (scratch[9][3])."""
+    primitive_poses(q, model, scratch)
+    count, last = model[8].shape[0], scratch[9][3]
+    if last < count:
+        out[last] = pair_bound(last, model, scratch) - clearance
+        if out[last] <= STALL_DISTANCE:
+            return False
+    for p in range(count):
+        if p != last:
+            out[p] = pair_bound(p, model, scratch) - clearance
+            if out[p] <= STALL_DISTANCE:
+                scratch[9][3] = p
+                return False
+    return True
+
+
+@numba.njit(cache=True)
+def edge_fraction(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
+) -> float:
+    """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1].
+
+    Returns -1 if q_a itself is not valid (:func:`edge_walk`).
+    """
+    return edge_walk(q_a, q_b, model, scratch, clearance, False)
+
+
+@numba.njit(cache=True)
+def edge_fraction_from(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    slack_a: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> float:
+    """:func:`edge_fraction` with the pairs' slacks at q_a already known (slack_a (P,), in [m],
+    from :func:`state_slacks` at exactly q_a): a tree node's, computed once."""
+    scratch[4][:] = slack_a
+    return edge_walk(q_a, q_b, model, scratch, clearance, True)
+
+
+@numba.njit(cache=True, inline="always")
+def _walk_start(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float, known: bool
+) -> bool:
+    """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and first
+    one-sided reach; False when a pair is within :data:`STALL_DISTANCE` at q_a."""
+    pairs, rates = model[8], model[9]
+    count = pairs.shape[0]
+    dq, counters, slack = scratch[14], scratch[9], scratch[4]
+    reach, where, all_arms, trend = scratch[5], scratch[6], scratch[15], scratch[16]
+    for j in range(q_a.shape[0]):
+        dq[j] = abs(q_b[j] - q_a[j])
+    counters[0] += 1
+    counters[1] += 1
+    counters[2] += count
+    primitive_poses(q_a, model, scratch)
+    for p in range(count):
+        if not known:
+            slack[p] = pair_bound(p, model, scratch) - clearance
+        if slack[p] <= STALL_DISTANCE:
+            counters[3] = p
+            return False
+        where[p] = 0.0
+        trend[p] = 0.0
+        static = 0.0
+        for j in range(dq.shape[0]):
+            static += rates[p, j] * dq[j]
+        if slack[p] >= static:  # certified to s = 1 by the static bound alone
+            reach[p] = np.inf
+            continue
+        lever_arms(p, scratch[0], scratch[3], model, all_arms[p])
+        reach[p] = reach_step(slack[p], p, all_arms[p], model, scratch)
+    return True
+
+
+@numba.njit(cache=True)
+def edge_walk(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float, known: bool
+) -> float:
+    """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
+    ``known``, scratch[4] holds the pairs' slacks at q_a.
+
+    Every pair keeps the last point s_p of the edge where its bound was evaluated, its slack
+    sigma_p above the clearance there, and the point it is certified to. The pair certified
+    least far is advanced next: it tries t = s_p + STEP_GROWTH ds (ds its one-sided step,
+    :func:`reach_step`) and is certified to t when ``sigma_p + sigma_t`` exceeds its motion
+    bound over [s_p, t] (:func:`span_motion`: at any u in between, one of the two ends is still
+    far enough); otherwise it is evaluated at s_p + ds, where it was certified one-sided. The
+    walk stops at the first point where a pair's slack is within :data:`STALL_DISTANCE`
+    (returned), or when every pair is certified to s = 1. Returns -1 if q_a itself is not
+    valid. Proof: module docstring.
+    """
+    count = model[8].shape[0]
+    counters, slack = scratch[9], scratch[4]
+    reach, where, arms, all_arms = scratch[5], scratch[6], scratch[13], scratch[15]
+    trend = scratch[16]
+    if not _walk_start(q_a, q_b, model, scratch, clearance, known):
+        return -1.0
+    while True:
+        p, nearest = 0, np.inf
+        for k in range(count):
+            if reach[k] < nearest:
+                p, nearest = k, reach[k]
+        if nearest >= 1.0:
+            return 1.0
+        s = where[p]
+        # Two-sided step length from the slack's trend (its change per unit s at the last step):
+        # the bound's speed V ~ slack / ds; the two ends' slacks sum to about 2 slack + trend t,
+        # enough while t < 2 slack / (V - trend). Approaching (trend ~ -V): one-sided steps.
+        one = nearest - s
+        speed = slack[p] / one
+        closing = speed - min(max(trend[p], -speed), speed)
+        span = STEP_GROWTH * slack[p] / closing if closing > 0.0 else MAX_GROWTH * one
+        arms[0, :] = all_arms[p]
+        if span > 1.2 * one:
+            t = min(1.0, s + min(span, MAX_GROWTH * one))
+            slack_t = _pair_at(q_a, q_b, t, p, model, scratch, 1) - clearance
+            if slack_t > STALL_DISTANCE and slack[p] + slack_t > span_motion(
+                p, t - s, model, scratch
+            ):
+                trend[p] = (slack_t - slack[p]) / (t - s)
+                where[p], slack[p] = t, slack_t
+                all_arms[p, :] = arms[1]
+                reach[p] = t + reach_step(slack_t, p, all_arms[p], model, scratch)
+                continue
+        slack_t = _pair_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
+        if slack_t <= STALL_DISTANCE:
+            counters[3] = p
+            return nearest
+        trend[p] = (slack_t - slack[p]) / one
+        where[p], slack[p] = nearest, slack_t
+        all_arms[p, :] = arms[1]
+        reach[p] = nearest + reach_step(slack_t, p, all_arms[p], model, scratch)
+
+
+@numba.njit(cache=True)
+def edge_is_free(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
+) -> bool:
+    """Whether the whole edge from q_a to q_b is certified (:func:`edge_fraction`)."""
+    return edge_fraction(q_a, q_b, model, scratch, clearance) >= 1.0
