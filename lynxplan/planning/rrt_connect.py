@@ -27,7 +27,7 @@ from __future__ import annotations
 import math
 import time
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
@@ -258,6 +258,40 @@ def _branch(nodes: np.ndarray, parents: np.ndarray, tree: int, index: int) -> li
     return branch
 
 
+#: Nodes each tree has room for at first; the arrays double when a kernel call might fill them.
+INITIAL_CAPACITY = 4096
+
+
+class _Trees(NamedTuple):
+    """The two trees' arrays (see :func:`rrt_connect_kernel`): nodes (2, M, nq), parents (2, M),
+    slacks (2, M, P), known (2, M); only the first counts[tree] rows of a tree are read."""
+
+    nodes: np.ndarray
+    parents: np.ndarray
+    slacks: np.ndarray
+    known: np.ndarray
+
+    @classmethod
+    def empty(cls, capacity: int, nq: int, pairs: int) -> _Trees:
+        # np.empty: rows are written before they are read (roots have parent -1), slacks are
+        # filled on first use (known)
+        return cls(
+            np.empty((2, capacity, nq)),
+            np.empty((2, capacity), dtype=np.int64),
+            np.empty((2, capacity, pairs)),
+            np.zeros((2, capacity), dtype=np.int8),
+        )
+
+    def grown(self, capacity: int) -> _Trees:
+        """The same trees in arrays of ``capacity`` rows."""
+        nq, pairs = self.nodes.shape[2], self.slacks.shape[2]
+        bigger = _Trees.empty(capacity, nq, pairs)
+        rows = self.nodes.shape[1]
+        for old, new in zip(self, bigger, strict=True):
+            new[:, :rows] = old
+        return bigger
+
+
 def _root_of(parents: np.ndarray, tree: int, index: int) -> int:
     while parents[tree, index] >= 0:
         index = int(parents[tree, index])
@@ -284,10 +318,14 @@ def rrt_connect(
     """
     began = time.perf_counter()
     nq = lower.size
-    capacity = settings.max_nodes + 1
-    # np.empty: only the first counts[tree] rows of a tree are ever read (roots have parent -1).
-    nodes = np.empty((2, capacity, nq))
-    parents = np.empty((2, capacity), dtype=np.int64)
+    limit = settings.max_nodes + 1
+    # Trees grow in blocks (a budget of 10^7 nodes must not reserve gigabytes up front); one
+    # kernel call adds at most CHUNK_ITERATIONS * (1 + pieces of the longest connect) nodes.
+    per_call = CHUNK_ITERATIONS * (
+        2 + math.ceil(float(np.linalg.norm(upper - lower)) / settings.step)
+    )
+    trees = _Trees.empty(min(limit, INITIAL_CAPACITY), nq, len(checker.pair_names))
+    nodes, parents, slacks, known = trees
     parents[0, 0] = -1
     parents[1, : len(goals)] = -1
     counts = np.array([1, len(goals)], dtype=np.int64)
@@ -296,15 +334,16 @@ def rrt_connect(
     roots = counts.copy()
     state = _rng.seed_state(seed)
     meta = np.array([0, -1, -1, 0], dtype=np.int64)
-    # Pair slacks per node, filled on first use (np.empty: untouched pages cost nothing).
-    slacks = np.empty((2, capacity, len(checker.pair_names)))
-    known = np.zeros((2, capacity), dtype=np.int8)
     model, scratch, clearance = checker.model, checker.scratch, checker.clearance
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.vstack([start, goals[k]])
         return RrtConnectResult(path, k, int(counts.sum()), 0, time.perf_counter() - began)
     while True:
+        capacity = nodes.shape[1]
+        if capacity < limit and int(counts.max()) + per_call >= capacity:
+            trees = trees.grown(min(limit, max(2 * capacity, int(counts.max()) + per_call + 1)))
+            nodes, parents, slacks, known = trees
         status = rrt_connect_kernel(
             lower,
             upper,
@@ -326,6 +365,10 @@ def rrt_connect(
         elapsed = time.perf_counter() - began
         if status == SOLVED:
             break
+        if status == NODE_LIMIT and nodes.shape[1] < limit:  # not the budget: grow, go on
+            trees = trees.grown(min(limit, 2 * nodes.shape[1]))
+            nodes, parents, slacks, known = trees
+            continue
         if status == NODE_LIMIT:
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes} reached"

@@ -135,3 +135,40 @@ def test_a_start_the_checker_cannot_certify_fails_at_once(arm: Arm) -> None:
     assert 0.002 < exact < 0.0022
     with pytest.raises(PlanningFailed, match=r"after 0 nodes .*start is too close to block"):
         Planner(arm, [placed]).solve(START, GOAL, time_limit=30.0)
+
+
+def test_a_huge_node_budget_reserves_no_memory_up_front() -> None:
+    """max_nodes = 10^7 on an unsolvable problem: the trees grow in blocks, so a process whose
+    address space is capped at 4 GiB searches until its time limit (it reserved gigabytes for
+    the node slacks before: the service's memory-capped workers failed at once)."""
+    import subprocess
+    import sys
+    import textwrap
+
+    script = textwrap.dedent(
+        """
+        import resource, sys, yaml
+        resource.setrlimit(resource.RLIMIT_AS, (4 << 30, 4 << 30))
+        import lynxplan
+        from lynxplan.exceptions import PlanningFailed
+        data = yaml.safe_load(open(sys.argv[1]).read())
+        data["planner"].update(time_limit=0.5, max_nodes=10_000_000)
+        result = lynxplan.run_scenario(data, sys.argv[2], quick=True)
+        print("solved", result.metrics["solved"])
+        """
+    )
+    from pathlib import Path
+
+    jar = Path(__file__).parents[2] / "scenarios" / "planning" / "u01_goal_in_jar.yaml"
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as folder:
+        done = subprocess.run(
+            [sys.executable, "-c", script, str(jar), str(Path(folder) / "out")],
+            capture_output=True,
+            text=True,
+            timeout=300,
+            check=False,
+        )
+    assert done.returncode in (0, 1), done.stderr[-2000:]
+    assert "solved False" in done.stdout, (done.stdout, done.stderr[-2000:])
