@@ -67,6 +67,7 @@ def polish_pose(
     jac: np.ndarray,
     origins: np.ndarray,
     normal: np.ndarray,
+    vectors: np.ndarray,
 ) -> None:
     """Gauss-Newton on the pose error of the exact chain, from a closed-form branch of the
     nearly identical ideal model (~1e-6 away): position error [m] and the rotation vector
@@ -75,12 +76,11 @@ def polish_pose(
     elbow); stops when the error stops falling by MIN_FALL (a step that made it worse undone).
 
     Scratch: pose, work (4, 4); jac (6, 5); origins (5, 6); normal (7, 5): J^T J, its LU row
-    order, and J^T e.
+    order, and J^T e; vectors (3, 6): the error, the step and the q before it.
     """
     previous = math.inf
-    e = np.empty(6)
-    step = np.empty(5)
-    before = q.copy()
+    e, step, before = vectors[0], vectors[1, :5], vectors[2, :5]
+    before[:] = q
     for _ in range(NEWTON_STEPS):
         chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
         for i in range(3):
@@ -141,11 +141,13 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
     jac: np.ndarray,
     origins: np.ndarray,
     normal: np.ndarray,
+    vectors: np.ndarray,
 ) -> bool:
     """The exact branches of one full pose (4, 4) where the orientation gives the roll, into
     the slot table out (B, SLOT_COLUMNS) (every slot written; NaN / 0 where no branch); ref (5,)
     [rad]. Returns whether an exact branch was found (the target is complete). The rest:
-    scratch, g (3, 4), pose and work (4, 4), q (5,), jac (6, 5), origins (5, 6), normal (7, 5).
+    scratch, g (3, 4), pose and work (4, 4), q (5,), jac (6, 5), origins (5, 6), normal (7, 5),
+    vectors (3, 6).
     """
     nb = out.shape[0]
     per_side = nb // 2
@@ -201,7 +203,9 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                 if branch(problem, 0.0, theta, elbow, q) > REACH_MISS:
                     continue
                 if not exact_model:
-                    polish_pose(placements, axes, target, q, pose, work, jac, origins, normal)
+                    polish_pose(
+                        placements, axes, target, q, pose, work, jac, origins, normal, vectors
+                    )
                 inside, err = settle(placements, axes, lower, upper, tol, target, q, pose, work)
                 angle = rotation_angle(target, pose)
                 if not (err <= POSE_EXACT and angle <= POSE_EXACT):
@@ -278,6 +282,7 @@ def pose_one(
         np.empty((6, 5)),
         np.empty((5, 6)),
         np.empty((7, 5)),
+        np.empty((3, 6)),
     )
     if not solved:
         return 0
@@ -324,10 +329,24 @@ def pose_kernel(
     pose, work = np.empty((4, 4)), np.empty((4, 4))
     q = np.empty(5)
     jac, origins, normal = np.empty((6, 5)), np.empty((5, 6)), np.empty((7, 5))
+    vectors = np.empty((3, 6))
     for n in range(targets.shape[0]):
         ref = reference[n if reference.shape[0] > 1 else 0]
         solved[n] = solve_target(
-            prm, placements, axes, targets[n], ref, out, g, pose, work, q, jac, origins, normal
+            prm,
+            placements,
+            axes,
+            targets[n],
+            ref,
+            out,
+            g,
+            pose,
+            work,
+            q,
+            jac,
+            origins,
+            normal,
+            vectors,
         )
         for b in range(nb):
             for j in range(5):
