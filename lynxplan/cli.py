@@ -59,16 +59,6 @@ EXIT_CODES: dict[int, str] = {
     EXIT_INTERRUPTED: "interrupted (Ctrl-C)",
 }
 
-COMMAND_MODULES = (
-    "lynxplan.commands.arm",
-    "lynxplan.commands.workspace",
-    "lynxplan.commands.run",
-    "lynxplan.commands.bench",
-    "lynxplan.commands.parallel",
-    "lynxplan.commands.scenario_tools",
-    "lynxplan.commands.serve",
-    "lynxplan.commands.robots",
-)
 
 #: The module that registers each sub-command: ``lynxplan CMD ...`` builds the parsers of CMD's
 #: module only (building all of them took ~8 ms of every start-up); ``lynxplan --help`` and an
@@ -86,6 +76,8 @@ COMMAND_OF: dict[str, str] = {
     "robots": "lynxplan.commands.robots",
     "robot": "lynxplan.commands.robots",
 }
+#: Every sub-command module, in the order of ``lynxplan --help``.
+COMMAND_MODULES = tuple(dict.fromkeys(COMMAND_OF.values()))
 
 
 class _Parser(argparse.ArgumentParser):
