@@ -75,15 +75,16 @@ def _atan_unit(t: float) -> float:
 def atan2(y: float, x: float) -> float:
     """Angle of the vector (x, y) in (-pi, pi], in [rad] (math.atan2 conventions for +-0).
 
-    The octant is applied by selects: random vectors cost no mispredicted branches."""
-    if x == 0.0:
-        if y == 0.0:
-            return math.copysign(math.pi, y) if math.copysign(1.0, x) < 0.0 else y
-        return math.copysign(0.5 * math.pi, y)
+    The octant is applied by selects, and so is the origin: no branch, so loops over arrays
+    of vectors vectorise (in a caller compiled with ``error_model="numpy"``, whose divisions
+    have no zero test)."""
     ay = abs(y)
     ax = abs(x)
     steep = ay > ax
-    a = _atan_unit((ax if steep else ay) / (ay if steep else ax))
+    big = ay if steep else ax
+    a = _atan_unit((ax if steep else ay) / (big if big > 0.0 else 1.0))
     a = 0.5 * math.pi - a if steep else a
     a = math.pi - a if x < 0.0 else a
-    return math.copysign(a, y)
+    general = math.copysign(a, y)
+    origin = math.copysign(math.pi, y) if math.copysign(1.0, x) < 0.0 else y
+    return origin if (x == 0.0) & (y == 0.0) else general
