@@ -81,6 +81,8 @@ class IkOutputs(NamedTuple):
 RIGIDITY_REPAIR_TOLERANCE_K = RIGIDITY_REPAIR_TOLERANCE
 BASE_AXIS_TOLERANCE_K = BASE_AXIS_TOLERANCE
 REACH_TOLERANCE_K = REACH_TOLERANCE
+#: Elbow cosines this close to +-1 are +-1 (a straight or folded elbow).
+FOLD_SNAP_K = 1e-14
 #: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
 FAR_AWAY_K = 1e9
 
@@ -300,7 +302,10 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         miss = dist - (a2 + a3) if dist > a2 + a3 else 0.0
         miss = abs(a2 - a3) - dist if dist < abs(a2 - a3) else miss
         c3 = (r_w * r_w + z_w * z_w - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
-        c3 = min(1.0, max(-1.0, c3))  # elbow stretched or folded: clamp
+        # Elbow stretched or folded: clamp, and snap within FOLD_SNAP (the last digits of c3
+        # decide an elbow angle of up to 1.4e-7 rad there, which moves the tool < 1e-15 m)
+        c3 = 1.0 if c3 > 1.0 - FOLD_SNAP_K else c3
+        c3 = -1.0 if c3 < FOLD_SNAP_K - 1.0 else c3
         s3 = math.sqrt(1.0 - c3 * c3)
         q3_abs = atan2(s3, c3)
         beta = atan2(a3 * s3, a2 + a3 * c3)
