@@ -198,7 +198,7 @@ _ROWS = _WITHIN + 4
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _max(x: float, y: float) -> float:
     """The larger of x and y, NaN when either is NaN (a select: vectorises)."""
-    return x if (x >= y) | (x != x) else y
+    return x if (x >= y) | math.isnan(x) else y
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
