@@ -93,6 +93,25 @@ def _joint_sincos(q: np.ndarray, work: np.ndarray, i: int) -> tuple[float, float
     return sincos(q[i])
 
 
+Mat3 = tuple[float, float, float, float, float, float, float, float, float]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _mul3(a: Mat3, b: Mat3) -> Mat3:
+    """The 3 x 3 product a b of row-major 9-tuples (kept in registers once inlined)."""
+    return (
+        a[0] * b[0] + a[1] * b[3] + a[2] * b[6],
+        a[0] * b[1] + a[1] * b[4] + a[2] * b[7],
+        a[0] * b[2] + a[1] * b[5] + a[2] * b[8],
+        a[3] * b[0] + a[4] * b[3] + a[5] * b[6],
+        a[3] * b[1] + a[4] * b[4] + a[5] * b[7],
+        a[3] * b[2] + a[4] * b[5] + a[5] * b[8],
+        a[6] * b[0] + a[7] * b[3] + a[8] * b[6],
+        a[6] * b[1] + a[7] * b[4] + a[8] * b[7],
+        a[6] * b[2] + a[7] * b[5] + a[8] * b[8],
+    )
+
+
 @numba.njit(cache=True, nogil=True, inline="always")
 def _fk_pass(
     placements: np.ndarray,
@@ -140,20 +159,9 @@ def _fk_pass(
         r00, r01, r02 = c + u0 * u0 * v, u0 * u1 * v - u2 * s, u0 * u2 * v + u1 * s
         r10, r11, r12 = u1 * u0 * v + u2 * s, c + u1 * u1 * v, u1 * u2 * v - u0 * s
         r20, r21, r22 = u2 * u0 * v - u1 * s, u2 * u1 * v + u0 * s, c + u2 * u2 * v
-        w00, w01, w02 = (
-            t00 * r00 + t01 * r10 + t02 * r20,
-            t00 * r01 + t01 * r11 + t02 * r21,
-            t00 * r02 + t01 * r12 + t02 * r22,
-        )
-        w10, w11, w12 = (
-            t10 * r00 + t11 * r10 + t12 * r20,
-            t10 * r01 + t11 * r11 + t12 * r21,
-            t10 * r02 + t11 * r12 + t12 * r22,
-        )
-        w20, w21, w22 = (
-            t20 * r00 + t21 * r10 + t22 * r20,
-            t20 * r01 + t21 * r11 + t22 * r21,
-            t20 * r02 + t21 * r12 + t22 * r22,
+        w00, w01, w02, w10, w11, w12, w20, w21, w22 = _mul3(
+            (t00, t01, t02, t10, t11, t12, t20, t21, t22),
+            (r00, r01, r02, r10, r11, r12, r20, r21, r22),
         )
         m = i + 1
         m00, m01, m02, m03 = (
@@ -177,20 +185,9 @@ def _fk_pass(
         t03 = w00 * m03 + w01 * m13 + w02 * m23 + t03
         t13 = w10 * m03 + w11 * m13 + w12 * m23 + t13
         t23 = w20 * m03 + w21 * m13 + w22 * m23 + t23
-        t00, t01, t02 = (
-            w00 * m00 + w01 * m10 + w02 * m20,
-            w00 * m01 + w01 * m11 + w02 * m21,
-            w00 * m02 + w01 * m12 + w02 * m22,
-        )
-        t10, t11, t12 = (
-            w10 * m00 + w11 * m10 + w12 * m20,
-            w10 * m01 + w11 * m11 + w12 * m21,
-            w10 * m02 + w11 * m12 + w12 * m22,
-        )
-        t20, t21, t22 = (
-            w20 * m00 + w21 * m10 + w22 * m20,
-            w20 * m01 + w21 * m11 + w22 * m21,
-            w20 * m02 + w21 * m12 + w22 * m22,
+        t00, t01, t02, t10, t11, t12, t20, t21, t22 = _mul3(
+            (w00, w01, w02, w10, w11, w12, w20, w21, w22),
+            (m00, m01, m02, m10, m11, m12, m20, m21, m22),
         )
     out[0, 0], out[0, 1], out[0, 2], out[0, 3] = t00, t01, t02, t03
     out[1, 0], out[1, 1], out[1, 2], out[1, 3] = t10, t11, t12, t13
