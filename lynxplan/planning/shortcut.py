@@ -1,6 +1,6 @@
 """Path shortcutting and smoothing, compiled with numba; every change is re-validated.
 
-Four passes over a piecewise-linear joint path, all with the planner's validity checker:
+Five passes over a piecewise-linear joint path, all with the planner's validity checker:
 
 1. *Greedy vertex shortcuts*: from the start, each kept waypoint is joined to the farthest
    later waypoint it sees directly (one quick midpoint test, then the certified edge), so the
@@ -9,22 +9,24 @@ Four passes over a piecewise-linear joint path, all with the planner's validity 
    another goal configuration when that shortens the path; the offset between the goals is
    blended in along the arc length, so a goal that differs in one joint (a roll) turns that
    joint during the whole motion instead of at the end.
-3. *Random shortcuts* (Geraerts & Overmars 2007), two kinds drawn at random between two
-   random points of the path by arc length (anywhere on its segments, not only at
-   waypoints): a *full* cut, the straight edge between the points; a *partial* cut, one joint
-   moved linearly in the arc length between them while the others keep their motion. The joint
-   is drawn in proportion to its excess motion (total variation beyond its net displacement):
-   RRT-Connect's random samples make joints that matter little for collisions (a wrist roll)
-   wander, and a full cut rarely removes that where the other joints must go around an
-   obstacle. A cut is kept when it shortens the path and every new edge is certified (a
-   partial cut must gain :data:`MIN_GAIN`); the passes stop after ``patience`` attempts in a
-   row that changed nothing.
-4. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
+3. *One-joint straightening*: a *partial* cut (Geraerts & Overmars 2007) moves one joint
+   linearly in the arc length between two points of the path while the others keep their
+   motion; it is tried for every joint over the whole path (:data:`FLATTEN_LEVELS` > 1: then
+   over its halves, ...). RRT-Connect's random samples make joints that matter little for
+   collisions (a wrist roll) wander, and a straight cut of all joints rarely removes that where
+   the others must go around an obstacle: most of the length the random cuts would take many
+   tries to remove goes here in one try per joint.
+4. *Random shortcuts* between two random points of the path by arc length (anywhere on its
+   segments, not only at waypoints): a *full* cut, the straight edge between the points, or
+   (a fraction ``partial`` of the attempts) a partial cut of one joint drawn in proportion to
+   its excess motion (total variation beyond its net displacement). The cuts stop after
+   ``patience`` attempts in a row that changed nothing.
+5. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
 
-The parts of the old path kept around a cut are pieces of certified edges, and every new edge
-is certified before a change is accepted: the path stays valid after every change ("verify
-after every shortcut" — pyroboplan's ``shortcut_path`` does not, and returns paths through
-obstacles).
+A cut is kept when it shortens the path (a partial cut by at least :data:`MIN_GAIN`) and every
+new edge is certified. The parts of the old path kept around a cut are pieces of certified
+edges: the path stays valid after every change ("verify after every shortcut" — pyroboplan's
+``shortcut_path`` does not, and returns paths through obstacles).
 """
 
 from __future__ import annotations
@@ -41,13 +43,15 @@ from lynxplan.planning.validity import ValidityChecker, point_is_clear
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
 #: Random cuts stop after this many attempts in a row that changed nothing.
-DEFAULT_SHORTCUT_PATIENCE = 10
+DEFAULT_SHORTCUT_PATIENCE = 3
 #: Fraction of the random attempts that are partial (one-joint) shortcuts.
 DEFAULT_PARTIAL_FRACTION = 0.5
 #: Joints that move less than this beyond their net displacement get no partial shortcut, [rad].
 WANDER_TOLERANCE = 1e-3
 #: A partial shortcut must shorten the path by at least this, in [rad].
 MIN_GAIN = 1e-3
+#: Levels of the one-joint straightening pass (:func:`_flatten`): whole path, halves, ...
+FLATTEN_LEVELS = 1
 #: Points closer than this in joint space are merged, in [rad].
 _MERGE_DISTANCE = 1e-9
 
@@ -131,7 +135,7 @@ def _full(
     first, second = piece[0], piece[1]
     i1 = _point_at(path, cumulative, count, u1, first)
     i2 = _point_at(path, cumulative, count, u2, second)
-    if i1 == i2:
+    if i1 == i2 or count + 2 > path.shape[0]:
         return 0
     if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
         not edge_is_free(first, second, model, scratch, clearance)
@@ -201,7 +205,7 @@ def _partial(
     first, second = piece[0], piece[1]
     i1 = _point_at(path, cumulative, count, u1, first)
     i2 = _point_at(path, cumulative, count, u2, second)
-    if i1 == i2:
+    if i1 == i2 or count + 2 > path.shape[0]:
         return 0
     # piece: first, waypoints i1+1..i2 with the joint re-interpolated, second.
     size = 1
@@ -239,6 +243,50 @@ def _partial(
     for k in range(total):
         path[k] = work[k]
     return total
+
+
+@numba.njit(cache=True)
+def _flatten(
+    path: np.ndarray,
+    count: int,
+    cumulative: np.ndarray,
+    levels: int,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    work: np.ndarray,
+    piece: np.ndarray,
+) -> int:
+    """Partial shortcuts of each joint over the whole path, then over its halves, ... (``levels``
+    levels: 2^level equal parts of the arc length at level ``level``), in place on
+    path[:count]; returns the new count. A joint that wanders over the whole path (a wrist roll
+    that turns away and back) is straightened in one try instead of many random ones."""
+    for level in range(levels):
+        parts = 2**level
+        for joint in range(path.shape[1]):
+            for part in range(parts):
+                if count < 3:
+                    return count
+                cumulative[0] = 0.0
+                for k in range(1, count):
+                    cumulative[k] = cumulative[k - 1] + _distance(path[k - 1], path[k])
+                total = cumulative[count - 1]
+                size = _partial(
+                    path,
+                    count,
+                    cumulative,
+                    total * part / parts,
+                    total * (part + 1) / parts,
+                    joint,
+                    model,
+                    scratch,
+                    clearance,
+                    work,
+                    piece,
+                )
+                if size > 0:
+                    count = size
+    return count
 
 
 @numba.njit(cache=True)
@@ -309,13 +357,15 @@ def shortcut_kernel(
     goals: np.ndarray,
     goal: np.ndarray,
     bounds: np.ndarray,
+    levels: int,
 ) -> int:
-    """Greedy vertex shortcuts (if ``greedy``), goal switch, random full and partial cuts (a
-    fraction ``partial`` of the attempts) then vertex pruning, in place on path[:count];
-    returns the new count.
+    """Greedy vertex shortcuts (if ``greedy``), goal switch, one-joint straightening over
+    ``levels`` levels, random full and partial cuts (a fraction ``partial`` of the attempts)
+    then vertex pruning, in place on path[:count]; returns the new count.
 
-    path: (capacity, nq) with capacity >= count + 2 * iterations; work: same shape. The cuts stop
-    early after ``patience`` attempts in a row that changed nothing. goals: (K, nq) goal
+    path: (capacity, nq); a cut adds at most two rows, and none is made once the capacity is
+    reached (count + 2 * (iterations + nq * (2^levels - 1)) suffices); work: same shape. The
+    cuts stop early after ``patience`` attempts in a row that changed nothing. goals: (K, nq) goal
     configurations; goal: (1,) the index of the one path[count - 1] is, updated; bounds:
     (2, nq) joint limits, in [rad].
     """
@@ -328,6 +378,7 @@ def shortcut_kernel(
         goal[0] = _switch_goal(
             path, count, goals, goal[0], bounds, model, scratch, clearance, piece
         )
+    count = _flatten(path, count, cumulative, levels, model, scratch, clearance, work, piece)
     idle = 0
     for _ in range(iterations):
         if count < 3 or idle >= patience:
@@ -453,6 +504,7 @@ def shortcut_to_goals(
     patience: int = DEFAULT_SHORTCUT_PATIENCE,
     greedy: bool = True,
     partial: float = DEFAULT_PARTIAL_FRACTION,
+    levels: int = FLATTEN_LEVELS,
 ) -> ShortcutResult:
     """:func:`shortcut` of a path (N, nq) that ends at ``goals[goal_index]`` (goals: (K, nq),
     in [rad], every one valid): the path may move its end to another goal configuration when
@@ -461,7 +513,7 @@ def shortcut_to_goals(
     """
     path = merge_collinear(path)
     count = len(path)
-    capacity = count + 2 * iterations + 2
+    capacity = count + 2 * (iterations + path.shape[1] * (2**levels - 1)) + 2
     buffer = np.zeros((capacity, path.shape[1]))
     buffer[:count] = path
     work = np.zeros_like(buffer)
@@ -484,5 +536,6 @@ def shortcut_to_goals(
         np.ascontiguousarray(goals, dtype=float),
         goal,
         bounds,
+        levels,
     )
     return ShortcutResult(buffer[:count].copy(), int(goal[0]))
