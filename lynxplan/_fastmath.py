@@ -34,18 +34,14 @@ _MOREBITS = 6.123233995736765886130e-17
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def sincos(x: float) -> tuple[float, float]:
-    """(sin x, cos x) with one range reduction. x in [rad]."""
-    sign_s = 1.0
-    ax = x
-    if ax < 0.0:
-        ax = -ax
-        sign_s = -1.0
+    """(sin x, cos x) with one range reduction. x in [rad].
+
+    Branch-free: the octant picks the polynomials and signs by selects, so random angles cost
+    no mispredicted branches (they cost more than the polynomials)."""
+    ax = abs(x)
     j = int(ax * _FOUR_OVER_PI)
+    j += j & 1  # map zeros to the origin
     y = float(j)
-    if j & 1:  # map zeros to the origin
-        j += 1
-        y += 1.0
-    j = j & 7
     z = ((ax - y * _DP1) - y * _DP2) - y * _DP3
     zz = z * z
     s = z + z * zz * (((((_S0 * zz + _S1) * zz + _S2) * zz + _S3) * zz + _S4) * zz + _S5)
@@ -54,42 +50,41 @@ def sincos(x: float) -> tuple[float, float]:
         - 0.5 * zz
         + zz * zz * (((((_C0 * zz + _C1) * zz + _C2) * zz + _C3) * zz + _C4) * zz + _C5)
     )
-    sign_c = 1.0
-    if j > 3:
-        j -= 4
-        sign_s, sign_c = -sign_s, -sign_c
-    if j > 1:
-        sign_c = -sign_c
-    if j == 1 or j == 2:  # noqa: PLR1714 (numba kernel: no set literal)
-        s, c = c, s
-    return sign_s * s, sign_c * c
+    # octant j in {0, 2, 4, 6} (mod 8): (s, c), (c, -s), (-s, -c), (-c, s)
+    swap = (j & 2) != 0
+    sign_s = 1.0 - 2.0 * float((j >> 2) & 1)
+    sign_c = 1.0 - 2.0 * float(((j >> 2) ^ (j >> 1)) & 1)
+    sine = c if swap else s
+    cosine = s if swap else c
+    return math.copysign(1.0, x) * sign_s * sine, sign_c * cosine
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def _atan_positive(x: float) -> float:
-    """atan(x) for x >= 0."""
-    if x > _T3P8:
-        y, x, extra = 0.5 * math.pi, -1.0 / x, _MOREBITS
-    elif x <= 0.66:
-        y, extra = 0.0, 0.0
-    else:
-        y, x, extra = 0.25 * math.pi, (x - 1.0) / (x + 1.0), 0.5 * _MOREBITS
+def _atan_unit(t: float) -> float:
+    """atan(t) for 0 <= t <= 1 (the reduction at 0.66 by selects, no branch)."""
+    big = t > 0.66
+    x = (t - 1.0 if big else t) / (t + 1.0 if big else 1.0)
     z = x * x
     p = (((_P0 * z + _P1) * z + _P2) * z + _P3) * z + _P4
     q = ((((z + _Q0) * z + _Q1) * z + _Q2) * z + _Q3) * z + _Q4
+    y, extra = (0.25 * math.pi, 0.5 * _MOREBITS) if big else (0.0, 0.0)
     return y + (x * z * p / q + x + extra)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def atan2(y: float, x: float) -> float:
-    """Angle of the vector (x, y) in (-pi, pi], in [rad] (math.atan2 conventions for +-0)."""
-    if x == 0.0:
-        if y == 0.0:
-            return math.copysign(math.pi, y) if math.copysign(1.0, x) < 0.0 else y
-        return math.copysign(0.5 * math.pi, y)
+    """Angle of the vector (x, y) in (-pi, pi], in [rad] (math.atan2 conventions for +-0).
+
+    The octant is applied by selects, and so is the origin: no branch, so loops over arrays
+    of vectors vectorise (in a caller compiled with ``error_model="numpy"``, whose divisions
+    have no zero test)."""
     ay = abs(y)
     ax = abs(x)
-    a = _atan_positive(ay / ax) if ay <= ax else 0.5 * math.pi - _atan_positive(ax / ay)
-    if x < 0.0:
-        a = math.pi - a
-    return math.copysign(a, y)
+    steep = ay > ax
+    big = ay if steep else ax
+    a = _atan_unit((ax if steep else ay) / (big if big > 0.0 else 1.0))
+    a = 0.5 * math.pi - a if steep else a
+    a = math.pi - a if x < 0.0 else a
+    general = math.copysign(a, y)
+    origin = math.copysign(math.pi, y) if math.copysign(1.0, x) < 0.0 else y
+    return origin if (x == 0.0) & (y == 0.0) else general

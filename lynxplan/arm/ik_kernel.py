@@ -134,6 +134,28 @@ def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float,
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _angle_of_matrix(
+    m00: float,
+    m01: float,
+    m02: float,
+    m10: float,
+    m11: float,
+    m12: float,
+    m20: float,
+    m21: float,
+    m22: float,
+) -> float:
+    """Rotation angle of the rotation matrix M, in [rad], accurate near 0 (atan2 of sine and
+    cosine; the small-angle series by a select, so array loops over it vectorise)."""
+    sx, sy, sz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
+    sine = math.sqrt(sx * sx + sy * sy + sz * sz)
+    cosine = 0.5 * (m00 + m11 + m22 - 1.0)
+    # Reachable targets are small angles: asin(x) = x + x^3/6 + O(x^5), exact to ~1e-21 rad.
+    small = (sine < 1e-4) & (cosine > 0.0)
+    return sine + sine * sine * sine / 6.0 if small else atan2(sine, cosine)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _angle_between_frames(
     n_t: np.ndarray,
     o_t: np.ndarray,
@@ -143,17 +165,17 @@ def _angle_between_frames(
     a_s: np.ndarray,
 ) -> float:
     """Rotation angle of R_t^T R_s, in [rad], accurate near 0 (atan2 of sine and cosine)."""
-    m00, m11, m22 = _dot3(n_t, n_s), _dot3(o_t, o_s), _dot3(a_t, a_s)
-    m01, m10 = _dot3(n_t, o_s), _dot3(o_t, n_s)
-    m02, m20 = _dot3(n_t, a_s), _dot3(a_t, n_s)
-    m12, m21 = _dot3(o_t, a_s), _dot3(a_t, o_s)
-    sx, sy, sz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
-    sine = math.sqrt(sx * sx + sy * sy + sz * sz)
-    cosine = 0.5 * (m00 + m11 + m22 - 1.0)
-    if sine < 1e-4 and cosine > 0.0:
-        # Reachable targets land here: asin(x) = x + x^3/6 + O(x^5), exact to ~1e-21 rad.
-        return sine + sine * sine * sine / 6.0
-    return atan2(sine, cosine)
+    return _angle_of_matrix(
+        _dot3(n_t, n_s),
+        _dot3(n_t, o_s),
+        _dot3(n_t, a_s),
+        _dot3(o_t, n_s),
+        _dot3(o_t, o_s),
+        _dot3(o_t, a_s),
+        _dot3(a_t, n_s),
+        _dot3(a_t, o_s),
+        _dot3(a_t, a_s),
+    )
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -180,47 +202,6 @@ def _rigidity_deviation(T: np.ndarray, k: int, approach_only: bool) -> float:
             dot = T[k, 0, i] * T[k, 0, j] + T[k, 1, i] * T[k, 1, j] + T[k, 2, i] * T[k, 2, j]
             dev = max(dev, abs(dot - (1.0 if i == j else 0.0)))
     return float(dev)
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _arm_plane(
-    px: float, py: float, approach: tuple[float, float, float], q1_ref: float, pitch_ref: float
-) -> tuple[float, float, float, float]:
-    """Step 2: the arm plane's radial unit vector ``(c1, s1)`` towards the tool point (front
-    branch) and the ``approach`` axis projected into it, ``(s234, c234)``; ``q1_ref`` and
-    ``pitch_ref`` (q2 + q3 + q4) in [rad] decide where the pose leaves them free. Scalars only:
-    array arguments would cost reference counting in the per-pose loop."""
-    ax, ay, az = approach
-    rho = math.sqrt(px * px + py * py)
-    if rho > BASE_AXIS_TOLERANCE_K:
-        c1, s1 = px / rho, py / rho
-    else:
-        # On the base axis q1 is free: face the approach if it leans, else keep the reference.
-        horizontal = math.hypot(ax, ay)
-        if horizontal > 1e-9:
-            c1, s1 = ax / horizontal, ay / horizontal
-        else:
-            c1, s1 = math.cos(q1_ref), math.sin(q1_ref)
-    # Approach projected into the plane: a_s = (c1 s234, s1 s234, -c234).
-    s234 = c1 * ax + s1 * ay
-    c234 = -az
-    norm = math.sqrt(s234 * s234 + c234 * c234)
-    if norm < 1e-12:  # approach normal to the arm plane: any pitch is as good
-        s234, c234 = sincos(pitch_ref)
-    else:
-        s234, c234 = s234 / norm, c234 / norm
-    return c1, s1, s234, c234
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _reach_miss(r_w: float, z_w: float, a2: float, a3: float) -> float:
-    """Step 3: how far the wrist centre (plane coordinates) lies outside the annulus, in [m]."""
-    dist = math.sqrt(r_w * r_w + z_w * z_w)
-    if dist > a2 + a3:
-        return dist - (a2 + a3)
-    if dist < abs(a2 - a3):
-        return abs(a2 - a3) - dist
-    return 0.0
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -272,49 +253,37 @@ def _write_branches(
             within_out[k, branch] = q1_in and q2_in and q3_in and q4_in and q5_in
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _approach_residual(a_t: np.ndarray, a_s: np.ndarray) -> float:
-    """Step 5 (approach only): angle between the target and reached approach axes, in [rad]."""
-    dot = _dot3(a_t, a_s)
-    cx = a_t[1] * a_s[2] - a_t[2] * a_s[1]
-    cy = a_t[2] * a_s[0] - a_t[0] * a_s[2]
-    cz = a_t[0] * a_s[1] - a_t[1] * a_s[0]
-    return atan2(math.sqrt(cx * cx + cy * cy + cz * cz), dot)
+#: Poses per block: the kernel makes three passes over a block (admit the poses, the closed
+#: form, write the branches), its per-pose scalars staying in L1 between them.
+BLOCK = 256
+# Rows of the block's scratch: inputs of the closed form (admit), then its outputs.
+_PX, _PY, _PZ, _AX, _AY, _AZ, _NX, _NY, _NZ, _Q1_REF, _PITCH_REF, _Q5_REF = range(12)
+_Q1, _Q234, _PHI, _Q5, _RW, _Q3_ABS, _BETA, _MISS, _RESIDUAL = range(12, 21)
+_ROWS = 21
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _reached_frame(
-    c1: float,
-    s1: float,
-    c234: float,
-    s234: float,
-    n_x4: float,
-    n_y4: float,
-    n_s: np.ndarray,
-    o_s: np.ndarray,
+def _admit(
+    T: np.ndarray,
+    q_ref: np.ndarray,
+    start: int,
+    m: int,
+    approach_only: bool,
+    out: IkOutputs,
+    s: np.ndarray,
+    admitted: np.ndarray,
 ) -> None:
-    """Step 5 (full pose): the reached ``n`` and ``o`` axes (same for every branch, before any
-    snapping onto a limit) from the arm plane and the roll components ``(n.x4, n.y4)``."""
-    h = math.sqrt(n_x4 * n_x4 + n_y4 * n_y4)
-    c5, s5 = (n_x4 / h, n_y4 / h) if h > 1e-300 else (1.0, 0.0)
-    x4x, x4y, x4z = c1 * c234, s1 * c234, s234
-    n_s[0], n_s[1], n_s[2] = c5 * x4x + s5 * s1, c5 * x4y - s5 * c1, c5 * x4z
-    o_s[0], o_s[1], o_s[2] = -s5 * x4x + c5 * s1, -s5 * x4y - c5 * c1, -s5 * x4z
-
-
-@numba.njit(cache=True, nogil=True, fastmath=_FAST)
-def ik_kernel(T: np.ndarray, q_ref: np.ndarray, params: IkParams, out: IkOutputs) -> None:
-    """IK of poses T (N, 4, 4) into ``out`` (see :class:`IkBatch`): admit the pose, find the arm
-    plane, check the reach, write the four branches, measure the orientation residual.
-
-    q_ref (M, 5) with M = 1 or N gives q1 on the base axis and q5 when the roll is free.
-    """
-    a2, a3, d5 = params.a2, params.a3, params.d5
-    n_t, o_t, a_t = np.empty(3), np.empty(3), np.empty(3)
-    n_s, o_s, a_s = np.empty(3), np.empty(3), np.empty(3)  # scratch of the residual
-    for k in range(T.shape[0]):
+    """Pass 1 over poses start .. start + m: step 1, admit the pose (finite, not far away,
+    rigid to the repair tolerance; else its status now), its position, Gram-Schmidt axes
+    and references into the scratch columns."""
+    a_t, n_t, o_t = np.empty(3), np.empty(3), np.empty(3)
+    for i in range(m):
         # Plain indices, no per-pose views: a view costs reference-count updates in numba.
+        k = start + i
         r_k = k if q_ref.shape[0] > 1 else 0
+        admitted[i] = False
+        for row in range(_ROWS):
+            s[row, i] = 0.0
         out.miss[k] = 0.0
         out.deviation[k] = 0.0
         if not _is_finite(T, k):
@@ -323,41 +292,135 @@ def ik_kernel(T: np.ndarray, q_ref: np.ndarray, params: IkParams, out: IkOutputs
         px, py, pz = T[k, 0, 3], T[k, 1, 3], T[k, 2, 3]
         far = max(abs(px), abs(py), abs(pz))
         if far > FAR_AWAY_K:  # keeps squares below overflow
-            out.miss[k] = far - (a2 + a3 + d5)
+            out.miss[k] = far  # the kernel subtracts the reach
             _mark_unsolved(k, IkStatus.OUT_OF_REACH, out)
             continue
-        out.deviation[k] = _rigidity_deviation(T, k, params.approach_only)
+        out.deviation[k] = _rigidity_deviation(T, k, approach_only)
         if out.deviation[k] > RIGIDITY_REPAIR_TOLERANCE_K:
             _mark_unsolved(k, IkStatus.NOT_RIGID, out)
             continue
-        for i in range(3):
-            a_t[i] = T[k, i, 2]
-            n_t[i] = T[k, i, 0]
-        _orthonormalise(a_t, n_t, o_t, params.approach_only)
-        pitch_ref = q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3]
-        approach = (a_t[0], a_t[1], a_t[2])
-        c1, s1, s234, c234 = _arm_plane(px, py, approach, q_ref[r_k, 0], pitch_ref)
-        # Wrist centre in plane coordinates (radial r, height z).
+        for j in range(3):
+            a_t[j] = T[k, j, 2]
+            n_t[j] = T[k, j, 0]
+        _orthonormalise(a_t, n_t, o_t, approach_only)
+        admitted[i] = True
+        s[_PX, i], s[_PY, i], s[_PZ, i] = px, py, pz
+        s[_AX, i], s[_AY, i], s[_AZ, i] = a_t[0], a_t[1], a_t[2]
+        s[_NX, i], s[_NY, i], s[_NZ, i] = n_t[0], n_t[1], n_t[2]
+        s[_Q1_REF, i] = q_ref[r_k, 0]
+        s[_PITCH_REF, i] = q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3]
+        s[_Q5_REF, i] = q_ref[r_k, 4]
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _closed_form(  # noqa: PLR0915 (one vectorised pass: every step is a select)
+    m: int, a2: float, a3: float, d5: float, approach_only: bool, s: np.ndarray
+) -> None:
+    """Pass 2, steps 2-3 and 5 over the block's columns: the arm plane, the reach, the angles of
+    the front branch, the orientation residual. No branch and no call: the loop vectorises
+    (the columns of poses not admitted compute values nobody reads)."""
+    for i in range(m):
+        px, py, pz = s[_PX, i], s[_PY, i], s[_PZ, i]
+        ax, ay, az = s[_AX, i], s[_AY, i], s[_AZ, i]
+        nx, ny, nz = s[_NX, i], s[_NY, i], s[_NZ, i]
+        # Step 2: the arm plane's radial unit vector (c1, s1) towards the tool point (front
+        # branch); on the base axis q1 is free: face the approach if it leans, else keep the
+        # reference. Then the approach projected into it, a_s = (c1 s234, s1 s234, -c234).
+        rho = math.sqrt(px * px + py * py)
+        horizontal = math.sqrt(ax * ax + ay * ay)
+        s_ref, c_ref = sincos(s[_Q1_REF, i])
+        leans = horizontal > 1e-9
+        c1 = ax / horizontal if leans else c_ref
+        s1 = ay / horizontal if leans else s_ref
+        off_axis = rho > BASE_AXIS_TOLERANCE_K
+        c1 = px / rho if off_axis else c1
+        s1 = py / rho if off_axis else s1
+        s234 = c1 * ax + s1 * ay
+        c234 = -az
+        norm = math.sqrt(s234 * s234 + c234 * c234)
+        s_pitch, c_pitch = sincos(s[_PITCH_REF, i])
+        normal = norm < 1e-12  # approach normal to the arm plane: any pitch is as good
+        s234 = s_pitch if normal else s234 / norm
+        c234 = c_pitch if normal else c234 / norm
+        # Step 3: the wrist centre in plane coordinates (radial r, height z), the reach miss.
         r_w = c1 * px + s1 * py - d5 * s234
         z_w = pz + d5 * c234
-        out.miss[k] = _reach_miss(r_w, z_w, a2, a3)
-        if not out.miss[k] <= REACH_TOLERANCE_K:  # also catches an overflowed (inf/NaN) miss
-            _mark_unsolved(k, IkStatus.OUT_OF_REACH, out)
-            continue
+        dist = math.sqrt(r_w * r_w + z_w * z_w)
+        miss = dist - (a2 + a3) if dist > a2 + a3 else 0.0
+        miss = abs(a2 - a3) - dist if dist < abs(a2 - a3) else miss
         c3 = (r_w * r_w + z_w * z_w - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
         c3 = min(1.0, max(-1.0, c3))  # elbow stretched or folded: clamp
         s3 = math.sqrt(1.0 - c3 * c3)
-        elbow_angles = (atan2(s3, c3), atan2(a3 * s3, a2 + a3 * c3))
         # Roll from n: q5 = atan2(n.y4, n.x4), x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0).
-        n_x4 = n_t[0] * c1 * c234 + n_t[1] * s1 * c234 + n_t[2] * s234
-        n_y4 = n_t[0] * s1 - n_t[1] * c1
-        q5_front = q_ref[r_k, 4] if params.approach_only else atan2(n_y4, n_x4)
-        front = (atan2(s1, c1), atan2(s234, c234), atan2(z_w, r_w), q5_front, r_w)
-        _write_branches(k, front, elbow_angles, params, out.q, out.within)
-        a_s[0], a_s[1], a_s[2] = c1 * s234, s1 * s234, -c234
-        if params.approach_only:
-            out.residual[k] = _approach_residual(a_t, a_s)
-        else:
-            _reached_frame(c1, s1, c234, s234, n_x4, n_y4, n_s, o_s)
-            out.residual[k] = _angle_between_frames(n_t, o_t, a_t, n_s, o_s, a_s)
-        out.status[k] = IkStatus.OK
+        n_x4 = nx * c1 * c234 + ny * s1 * c234 + nz * s234
+        n_y4 = nx * s1 - ny * c1
+        s[_Q3_ABS, i] = atan2(s3, c3)
+        s[_BETA, i] = atan2(a3 * s3, a2 + a3 * c3)
+        s[_Q1, i] = atan2(s1, c1)
+        s[_Q234, i] = atan2(s234, c234)
+        s[_PHI, i] = atan2(z_w, r_w)
+        s[_Q5, i] = s[_Q5_REF, i] if approach_only else atan2(n_y4, n_x4)
+        s[_RW, i] = r_w
+        s[_MISS, i] = miss
+        # Step 5: the residual. The reached approach a_s; approach targets: its angle to the
+        # target's; full poses: the reached n and o axes (the same for every branch, before any
+        # snapping onto a limit) and the angle of R_t^T R_s.
+        as0, as1, as2 = c1 * s234, s1 * s234, -c234
+        cx, cy, cz = ay * as2 - az * as1, az * as0 - ax * as2, ax * as1 - ay * as0
+        dot = ax * as0 + ay * as1 + az * as2
+        approach_residual = atan2(math.sqrt(cx * cx + cy * cy + cz * cz), dot)
+        h = math.sqrt(n_x4 * n_x4 + n_y4 * n_y4)
+        c5 = n_x4 / h if h > 1e-300 else 1.0
+        s5 = n_y4 / h if h > 1e-300 else 0.0
+        x4x, x4y, x4z = c1 * c234, s1 * c234, s234
+        ns0, ns1, ns2 = c5 * x4x + s5 * s1, c5 * x4y - s5 * c1, c5 * x4z
+        os0, os1, os2 = -s5 * x4x + c5 * s1, -s5 * x4y - c5 * c1, -s5 * x4z
+        ox, oy, oz = ay * nz - az * ny, az * nx - ax * nz, ax * ny - ay * nx  # o_t = a_t x n_t
+        frame_residual = _angle_of_matrix(
+            nx * ns0 + ny * ns1 + nz * ns2,
+            nx * os0 + ny * os1 + nz * os2,
+            nx * as0 + ny * as1 + nz * as2,
+            ox * ns0 + oy * ns1 + oz * ns2,
+            ox * os0 + oy * os1 + oz * os2,
+            ox * as0 + oy * as1 + oz * as2,
+            ax * ns0 + ay * ns1 + az * ns2,
+            ax * os0 + ay * os1 + az * os2,
+            dot,
+        )
+        s[_RESIDUAL, i] = approach_residual if approach_only else frame_residual
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
+def ik_kernel(T: np.ndarray, q_ref: np.ndarray, params: IkParams, out: IkOutputs) -> None:
+    """IK of poses T (N, 4, 4) into ``out`` (see :class:`IkBatch`): admit the pose, find the arm
+    plane, check the reach, write the four branches, measure the orientation residual.
+
+    q_ref (M, 5) with M = 1 or N gives q1 on the base axis and q5 when the roll is free.
+    Blocks of BLOCK poses, three passes each: admit (scalar), the closed form (one
+    vectorised loop), the branches (scalar: the limits); compiled with numpy's error model
+    (a division by zero gives inf or NaN instead of a test per division).
+    """
+    a2, a3, d5 = params.a2, params.a3, params.d5
+    n = T.shape[0]
+    # a constant width: the rows' distance is known at compile time, so the closed form's
+    # loop needs no run-time aliasing checks between them (and vectorises)
+    s = np.empty((_ROWS, BLOCK))
+    admitted = np.empty(BLOCK, dtype=np.bool_)
+    for start in range(0, n, BLOCK):
+        m = min(BLOCK, n - start)
+        _admit(T, q_ref, start, m, params.approach_only, out, s, admitted)
+        _closed_form(m, a2, a3, d5, params.approach_only, s)
+        for i in range(m):
+            k = start + i
+            if not admitted[i]:
+                if out.status[k] == IkStatus.OUT_OF_REACH:
+                    out.miss[k] -= a2 + a3 + d5
+                continue
+            out.miss[k] = s[_MISS, i]
+            if not out.miss[k] <= REACH_TOLERANCE_K:  # also catches an overflowed miss
+                _mark_unsolved(k, IkStatus.OUT_OF_REACH, out)
+                continue
+            front = (s[_Q1, i], s[_Q234, i], s[_PHI, i], s[_Q5, i], s[_RW, i])
+            _write_branches(k, front, (s[_Q3_ABS, i], s[_BETA, i]), params, out.q, out.within)
+            out.residual[k] = s[_RESIDUAL, i]
+            out.status[k] = IkStatus.OK

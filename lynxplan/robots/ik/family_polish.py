@@ -249,16 +249,20 @@ def settle(
     q: np.ndarray,
     pose: np.ndarray,
     work: np.ndarray,
+    current: bool = False,
 ) -> tuple[bool, float]:
     """A branch's angles q (5,) wrapped into the limits in place (snapping within tol); its
-    pose on the exact chain into pose (4, 4) (work: scratch). Returns (within the limits,
-    position error against target [m])."""
+    pose on the exact chain into pose (4, 4) (work: scratch), unless pose is ``current`` (holds
+    the pose at q) and no angle moved. Returns (within the limits, position error against
+    target [m])."""
     inside = True
     for j in range(5):
         x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)
+        current = current and x == q[j]
         q[j] = x
         inside = inside and ok
-    chain_fk(placements, axes, q, pose, work)
+    if not current:
+        chain_fk(placements, axes, q, pose, work)
     err = 0.0
     for i in range(3):
         d = pose[i, 3] - target[i, 3]

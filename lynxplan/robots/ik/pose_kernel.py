@@ -25,7 +25,7 @@ import numba
 import numpy as np
 
 from lynxplan.robots import family as F  # noqa: N812
-from lynxplan.robots.chain import chain_fk_jacobian
+from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
 from lynxplan.robots.ik.family_geometry import MODE_POSE, best_roll, branch, pitch_sum, wrap, yaw
 from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
 from lynxplan.robots.ik.family_polish import (
@@ -57,7 +57,7 @@ MIN_FALL = 2.0
 
 
 @numba.njit(cache=True, nogil=True)
-def polish_pose(
+def polish_pose(  # noqa: PLR0912 (numba: one compiled loop)
     placements: np.ndarray,
     axes: np.ndarray,
     target: np.ndarray,
@@ -68,21 +68,34 @@ def polish_pose(
     origins: np.ndarray,
     normal: np.ndarray,
     vectors: np.ndarray,
-) -> None:
+) -> bool:
     """Gauss-Newton on the pose error of the exact chain, from a closed-form branch of the
     nearly identical ideal model (~1e-6 away): position error [m] and the rotation vector
     vee(R Rt^T - Rt R^T) / 2 [rad] against the geometric Jacobian (6, 5). The target is reachable
     exactly (zero residual), so it converges quadratically (linearly next to a fold of the
     elbow); stops when the error stops falling by MIN_FALL (a step that made it worse undone).
 
+    The chord method: the Jacobian and its factors are kept while the error falls by MIN_FALL
+    (from 1e-6 away the first Jacobian is 1e-6 from the last one, so the chord steps fall as
+    fast as Newton's: 1e-6, 1e-12, 1e-18), each later step costing a pose instead of a pose and
+    a Jacobian; after a chord step that stalls, Newton steps from the better of the two q, and
+    the polish stops when a Newton step stalls.
+
     Scratch: pose, work (4, 4); jac (6, 5); origins (5, 6); normal (7, 5): J^T J, its LU row
-    order, and J^T e; vectors (3, 6): the error, the step and the q before it.
+    order, and J^T e; vectors (3, 6): the error, the step and the q before it. Returns whether
+    pose holds the exact chain's pose at the final q (False after an undone step).
     """
     previous = math.inf
+    factored = False  # normal holds the factors of J^T J of the last fresh Jacobian in jac
+    chord = True  # until a chord step stalls; then Newton to the end
     e, step, before = vectors[0], vectors[1, :5], vectors[2, :5]
     before[:] = q
     for _ in range(NEWTON_STEPS):
-        chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
+        fresh = not (factored and chord)
+        if fresh:
+            chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
+        else:
+            chain_fk(placements, axes, q, pose, work)
         for i in range(3):
             e[i] = pose[i, 3] - target[i, 3]
         # R Rt^T - Rt R^T, its vee / 2: the small rotation from the target to the pose
@@ -98,27 +111,42 @@ def polish_pose(
         size = 0.0
         for i in range(6):
             size = max(size, abs(e[i]))
-        if size < NEWTON_TOLERANCE or not size * MIN_FALL <= previous:
-            if not size <= previous:  # the last step made it worse: undo it
+        if size < NEWTON_TOLERANCE:
+            return True
+        if not size * MIN_FALL <= previous:
+            worse = not size <= previous
+            if fresh:  # a step with a fresh Jacobian stalled: stop (undo it if it made it worse)
+                if worse:
+                    q[:] = before
+                return not worse
+            # a chord step stalled: a fresh Jacobian at the better of the two, judged afresh
+            if worse:
                 q[:] = before
-            return
+            chord = False
+            previous = math.inf
+            continue
         previous = size
         before[:] = q
+        if fresh:
+            for i in range(5):
+                for j in range(5):
+                    total = 0.0
+                    for k in range(6):
+                        total += jac[k, i] * jac[k, j]
+                    normal[i, j] = total
+            if not lu_factor(normal[:6]):
+                return True
+            factored = True
         for i in range(5):
             total = 0.0
             for k in range(6):
                 total += jac[k, i] * e[k]
             normal[6, i] = total
-            for j in range(5):
-                total = 0.0
-                for k in range(6):
-                    total += jac[k, i] * jac[k, j]
-                normal[i, j] = total
-        if not lu_factor(normal[:6]):
-            return
         lu_solve(normal[:6], normal[6], step)
         for j in range(5):
             q[j] -= step[j]
+    chain_fk(placements, axes, q, pose, work)
+    return True
 
 
 #: Columns of one target's slot table (``solve_target``): q (5), then these.
@@ -202,11 +230,14 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                     continue
                 if branch(problem, 0.0, theta, elbow, q) > REACH_MISS:
                     continue
+                current = False
                 if not exact_model:
-                    polish_pose(
+                    current = polish_pose(
                         placements, axes, target, q, pose, work, jac, origins, normal, vectors
                     )
-                inside, err = settle(placements, axes, lower, upper, tol, target, q, pose, work)
+                inside, err = settle(
+                    placements, axes, lower, upper, tol, target, q, pose, work, current
+                )
                 angle = rotation_angle(target, pose)
                 if not (err <= POSE_EXACT and angle <= POSE_EXACT):
                     continue
