@@ -53,8 +53,11 @@ class RrtConnectSettings:
         max_nodes: Node budget of each tree.
     """
 
-    step: float = 0.6
-    goal_bias: float = 0.1
+    # Measured on the AL5 suite (20 seeds): against 0.6 rad / 0.1, a third less search and
+    # shortcut work at the mean for paths as short (the one-joint straightening removes the
+    # wander of longer random steps).
+    step: float = 1.5
+    goal_bias: float = 0.05
     max_nodes: int = 20000
 
 

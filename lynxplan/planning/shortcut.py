@@ -43,7 +43,7 @@ from lynxplan.planning.validity import ValidityChecker, point_is_clear
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
 #: Random cuts stop after this many attempts in a row that changed nothing.
-DEFAULT_SHORTCUT_PATIENCE = 3
+DEFAULT_SHORTCUT_PATIENCE = 5
 #: Fraction of the random attempts that are partial (one-joint) shortcuts.
 DEFAULT_PARTIAL_FRACTION = 0.5
 #: Joints that move less than this beyond their net displacement get no partial shortcut, [rad].
