@@ -407,7 +407,9 @@ def shortcut_kernel(
             count, idle = size, 0
     k = 1
     while k < count - 1:
-        if edge_is_free(path[k - 1], path[k + 1], model, scratch, clearance):
+        if point_is_clear(
+            path[k - 1], path[k + 1], 0.5, model, scratch, clearance
+        ) and edge_is_free(path[k - 1], path[k + 1], model, scratch, clearance):
             for m in range(k, count - 1):
                 path[m] = path[m + 1]
             count -= 1
