@@ -81,6 +81,8 @@ class IkOutputs(NamedTuple):
 RIGIDITY_REPAIR_TOLERANCE_K = RIGIDITY_REPAIR_TOLERANCE
 BASE_AXIS_TOLERANCE_K = BASE_AXIS_TOLERANCE
 REACH_TOLERANCE_K = REACH_TOLERANCE
+#: Elbow cosines this close to +-1 are +-1 (a straight or folded elbow).
+FOLD_SNAP_K = 1e-14
 #: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
 FAR_AWAY_K = 1e9
 
@@ -103,17 +105,6 @@ def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: 
     o[0] = a[1] * n[2] - a[2] * n[1]
     o[1] = a[2] * n[0] - a[0] * n[2]
     o[2] = a[0] * n[1] - a[1] * n[0]
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _mark_unsolved(k: int, status: int, out: IkOutputs) -> None:
-    """Status of pose k, NaN angles and residual, no branch within limits (loops: no views)."""
-    out.status[k] = status
-    out.residual[k] = np.nan
-    for b in range(4):
-        out.within[k, b] = False
-        for j in range(5):
-            out.q[k, b, j] = np.nan
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -179,150 +170,112 @@ def _angle_between_frames(
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _is_finite(T: np.ndarray, k: int) -> bool:
-    """Step 1a: whether pose k has no NaN or infinity."""
-    finite = True
-    for i in range(4):
-        for j in range(4):
-            if not math.isfinite(T[k, i, j]):
-                finite = False
-    return finite
+def _wrap(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
+    """:func:`wrap_into_limits` by selects (no branch: array loops over it vectorise)."""
+    inside = (lo <= x) & (x <= hi)
+    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
+    snap_hi = y <= hi + tol
+    snap_lo = y >= lo + TWO_PI - tol
+    nearest = y if y - hi <= lo + TWO_PI - y else y - TWO_PI
+    out = lo if snap_lo else nearest
+    out = hi if snap_hi else out
+    out = y if y <= hi else out
+    return (x if inside else out), inside | snap_hi | snap_lo
+
+
+#: Poses per block: the kernel transposes a block into scratch rows (one row a quantity),
+#: solves it in one vectorised loop and transposes the results back; the rows stay in L1.
+BLOCK = 128
+# Rows of the block's scratch: the pose (row 4 i + j: T[i, j]), the references, then the results
+# (q of branch b, joint j: row _Q + 5 b + j; the within-limit flags of branch b: _WITHIN + b).
+_Q1_REF, _PITCH_REF, _Q5_REF = 16, 17, 18
+_STATUS, _MISS, _DEVIATION, _RESIDUAL = 19, 20, 21, 22
+_Q = 23
+_WITHIN = _Q + 20
+_ROWS = _WITHIN + 4
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _rigidity_deviation(T: np.ndarray, k: int, approach_only: bool) -> float:
-    """Step 1b: ``max |R^T R - I|`` and the bottom row's deviation of pose k (only the approach
-    axis's norm when ``approach_only``); up to the repair tolerance, Gram-Schmidt repairs it."""
-    dev = max(abs(T[k, 3, 0]), abs(T[k, 3, 1]), abs(T[k, 3, 2]), abs(T[k, 3, 3] - 1.0))
-    if approach_only:
-        norm2 = T[k, 0, 2] * T[k, 0, 2] + T[k, 1, 2] * T[k, 1, 2] + T[k, 2, 2] * T[k, 2, 2]
-        return float(max(dev, abs(math.sqrt(norm2) - 1.0)))
-    for i in range(3):
-        for j in range(i, 3):  # R^T R is symmetric
-            dot = T[k, 0, i] * T[k, 0, j] + T[k, 1, i] * T[k, 1, j] + T[k, 2, i] * T[k, 2, j]
-            dev = max(dev, abs(dot - (1.0 if i == j else 0.0)))
-    return float(dev)
+def _max(x: float, y: float) -> float:
+    """The larger of x and y, NaN when either is NaN (a select: vectorises)."""
+    return x if (x >= y) | (x != x) else y
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _write_branches(
-    k: int,
-    front: tuple[float, float, float, float, float],
-    elbow_angles: tuple[float, float],
-    params: IkParams,
-    q_out: np.ndarray,
-    within_out: np.ndarray,
-) -> None:
-    """Step 4: the four branches of pose k from the front branch's ``(q1, q234, phi, q5, r_w)``
-    and the elbow's ``(|q3|, beta)``, wrapped into the limits with their within-limit flags."""
-    q1_front, q234_front, phi_front, q5_front, r_w = front
-    q3_abs, beta = elbow_angles
-    lower, upper, tol = params.lower, params.upper, params.limit_tol
-    # q3 takes the values -q3_abs and +q3_abs, q1 and q5 one value per base branch: wrap
-    # each once (14 wraps a pose instead of 20).
-    q3_neg, q3_neg_in = wrap_into_limits(-q3_abs, lower[2], upper[2], tol)
-    q3_pos, q3_pos_in = wrap_into_limits(q3_abs, lower[2], upper[2], tol)
-    for base in range(2):
-        # The back branch (plane direction reversed) follows from identities instead of more
-        # atan2 calls: q1 + pi, q234 -> -q234, phi -> pi - phi, q5 + pi.
-        if base == 0:
-            q1, q234, phi, q5, r_b = q1_front, q234_front, phi_front, q5_front, r_w
-        else:
-            q1 = q1_front - math.pi if q1_front > 0.0 else q1_front + math.pi
-            q234 = -q234_front
-            phi = math.pi - phi_front if phi_front >= 0.0 else -math.pi - phi_front
-            if not params.approach_only:
-                q5 = q5_front - math.pi if q5_front > 0.0 else q5_front + math.pi
-            r_b = -r_w
-        q1_wrapped, q1_in = wrap_into_limits(q1, lower[0], upper[0], tol)
-        q5_wrapped, q5_in = wrap_into_limits(q5, lower[4], upper[4], tol)
-        for elbow in range(2):
-            # Elbow above the shoulder-wrist line: q3 < 0 when the wrist is ahead (r_b >= 0).
-            negative = (elbow == 0) == (r_b >= 0.0)
-            q2 = phi + beta if negative else phi - beta
-            q4 = q234 - q2 - (-q3_abs if negative else q3_abs)
-            q2_wrapped, q2_in = wrap_into_limits(q2, lower[1], upper[1], tol)
-            q4_wrapped, q4_in = wrap_into_limits(q4, lower[3], upper[3], tol)
-            branch = 2 * base + elbow
-            q_out[k, branch, 0] = q1_wrapped
-            q_out[k, branch, 1] = q2_wrapped
-            q_out[k, branch, 2] = q3_neg if negative else q3_pos
-            q_out[k, branch, 3] = q4_wrapped
-            q_out[k, branch, 4] = q5_wrapped
-            q3_in = q3_neg_in if negative else q3_pos_in
-            within_out[k, branch] = q1_in and q2_in and q3_in and q4_in and q5_in
-
-
-#: Poses per block: the kernel makes three passes over a block (admit the poses, the closed
-#: form, write the branches), its per-pose scalars staying in L1 between them.
-BLOCK = 256
-# Rows of the block's scratch: inputs of the closed form (admit), then its outputs.
-_PX, _PY, _PZ, _AX, _AY, _AZ, _NX, _NY, _NZ, _Q1_REF, _PITCH_REF, _Q5_REF = range(12)
-_Q1, _Q234, _PHI, _Q5, _RW, _Q3_ABS, _BETA, _MISS, _RESIDUAL = range(12, 21)
-_ROWS = 21
+def _admit(s: np.ndarray, i: int, approach_only: bool) -> tuple[float, ...]:
+    """Step 1 for column i: (finite, far, deviation, a (3), n (3)): finite is 0 for a finite
+    pose (x * 0 is NaN for NaN and infinity), far its largest coordinate [m] (squares overflow
+    beyond FAR_AWAY_K), deviation max |R^T R - I| and the bottom row's (only the approach axis's
+    norm when approach_only); a and n by Gram-Schmidt from the approach axis."""
+    finite = (s[0, i] + s[1, i] + s[2, i] + s[3, i] + s[4, i] + s[5, i] + s[6, i] + s[7, i]) * 0.0
+    finite += (s[8, i] + s[9, i] + s[10, i] + s[11, i]) * 0.0
+    finite += (s[12, i] + s[13, i] + s[14, i] + s[15, i]) * 0.0
+    r00, r01, r02, px = s[0, i], s[1, i], s[2, i], s[3, i]
+    r10, r11, r12, py = s[4, i], s[5, i], s[6, i], s[7, i]
+    r20, r21, r22, pz = s[8, i], s[9, i], s[10, i], s[11, i]
+    far = _max(_max(abs(px), abs(py)), abs(pz))
+    bottom = _max(_max(abs(s[12, i]), abs(s[13, i])), _max(abs(s[14, i]), abs(s[15, i] - 1.0)))
+    a_norm = math.sqrt(r02 * r02 + r12 * r12 + r22 * r22)
+    d00 = r00 * r00 + r10 * r10 + r20 * r20 - 1.0
+    d11 = r01 * r01 + r11 * r11 + r21 * r21 - 1.0
+    d22 = r02 * r02 + r12 * r12 + r22 * r22 - 1.0
+    d01 = r00 * r01 + r10 * r11 + r20 * r21
+    d02 = r00 * r02 + r10 * r12 + r20 * r22
+    d12 = r01 * r02 + r11 * r12 + r21 * r22
+    full = _max(_max(_max(abs(d00), abs(d11)), _max(abs(d22), abs(d01))), _max(abs(d02), abs(d12)))
+    deviation = _max(bottom, abs(a_norm - 1.0) if approach_only else full)
+    scale = 1.0 / a_norm
+    ax, ay, az = r02 * scale, r12 * scale, r22 * scale
+    along = r00 * ax + r10 * ay + r20 * az
+    nx, ny, nz = r00 - along * ax, r10 - along * ay, r20 - along * az
+    scale = 1.0 / math.sqrt(nx * nx + ny * ny + nz * nz)
+    return finite, far, deviation, ax, ay, az, nx * scale, ny * scale, nz * scale
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _admit(
-    T: np.ndarray,
-    q_ref: np.ndarray,
-    start: int,
-    m: int,
-    approach_only: bool,
-    out: IkOutputs,
+def _branch(
     s: np.ndarray,
-    admitted: np.ndarray,
+    i: int,
+    b: int,
+    base: tuple[float, bool, float, bool, float, float],
+    negative: bool,
+    common: tuple[float, float, float, bool, float, bool, float, float, float, float, float],
+    solved: bool,
 ) -> None:
-    """Pass 1 over poses start .. start + m: step 1, admit the pose (finite, not far away,
-    rigid to the repair tolerance; else its status now), its position, Gram-Schmidt axes
-    and references into the scratch columns."""
-    a_t, n_t, o_t = np.empty(3), np.empty(3), np.empty(3)
-    for i in range(m):
-        # Plain indices, no per-pose views: a view costs reference-count updates in numba.
-        k = start + i
-        r_k = k if q_ref.shape[0] > 1 else 0
-        admitted[i] = False
-        for row in range(_ROWS):
-            s[row, i] = 0.0
-        out.miss[k] = 0.0
-        out.deviation[k] = 0.0
-        if not _is_finite(T, k):
-            _mark_unsolved(k, IkStatus.NON_FINITE, out)
-            continue
-        px, py, pz = T[k, 0, 3], T[k, 1, 3], T[k, 2, 3]
-        far = max(abs(px), abs(py), abs(pz))
-        if far > FAR_AWAY_K:  # keeps squares below overflow
-            out.miss[k] = far  # the kernel subtracts the reach
-            _mark_unsolved(k, IkStatus.OUT_OF_REACH, out)
-            continue
-        out.deviation[k] = _rigidity_deviation(T, k, approach_only)
-        if out.deviation[k] > RIGIDITY_REPAIR_TOLERANCE_K:
-            _mark_unsolved(k, IkStatus.NOT_RIGID, out)
-            continue
-        for j in range(3):
-            a_t[j] = T[k, j, 2]
-            n_t[j] = T[k, j, 0]
-        _orthonormalise(a_t, n_t, o_t, approach_only)
-        admitted[i] = True
-        s[_PX, i], s[_PY, i], s[_PZ, i] = px, py, pz
-        s[_AX, i], s[_AY, i], s[_AZ, i] = a_t[0], a_t[1], a_t[2]
-        s[_NX, i], s[_NY, i], s[_NZ, i] = n_t[0], n_t[1], n_t[2]
-        s[_Q1_REF, i] = q_ref[r_k, 0]
-        s[_PITCH_REF, i] = q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3]
-        s[_Q5_REF, i] = q_ref[r_k, 4]
+    """Step 4 for branch b of column i: base = (q1, q1 within, q5, q5 within, phi, q234) of its
+    side (front or back, q1 and q5 wrapped), ``negative``: q3 < 0 (the elbow above the
+    shoulder-wrist line when the wrist is ahead); q2 and q4 follow and are wrapped; NaN and
+    not within when the pose is not solved."""
+    q1, q1_in, q5, q5_in, phi, q234 = base
+    beta, q3_abs, q3_neg, q3_neg_in, q3_pos, q3_pos_in, lo2, hi2, lo4, hi4, tol = common
+    q2 = phi + beta if negative else phi - beta
+    q4 = q234 - q2 - (-q3_abs if negative else q3_abs)
+    q2w, q2_in = _wrap(q2, lo2, hi2, tol)
+    q4w, q4_in = _wrap(q4, lo4, hi4, tol)
+    row = _Q + 5 * b
+    s[row, i] = q1 if solved else np.nan
+    s[row + 1, i] = q2w if solved else np.nan
+    s[row + 2, i] = (q3_neg if negative else q3_pos) if solved else np.nan
+    s[row + 3, i] = q4w if solved else np.nan
+    s[row + 4, i] = q5 if solved else np.nan
+    q3_in = q3_neg_in if negative else q3_pos_in
+    within = q1_in & q2_in & q3_in & q4_in & q5_in & solved
+    s[_WITHIN + b, i] = 1.0 if within else 0.0
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _closed_form(  # noqa: PLR0915 (one vectorised pass: every step is a select)
-    m: int, a2: float, a3: float, d5: float, approach_only: bool, s: np.ndarray
+def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
+    m: int, params: IkParams, s: np.ndarray
 ) -> None:
-    """Pass 2, steps 2-3 and 5 over the block's columns: the arm plane, the reach, the angles of
-    the front branch, the orientation residual. No branch and no call: the loop vectorises
-    (the columns of poses not admitted compute values nobody reads)."""
+    """IK of the block's m columns (see :func:`ik_kernel`): no branch and no call, so the loop
+    vectorises (a pose that is not admitted computes values that are then replaced)."""
+    a2, a3, d5, tol = params.a2, params.a3, params.d5, params.limit_tol
+    lower, upper, approach_only = params.lower, params.upper, params.approach_only
+    lo1, lo2, lo3, lo4, lo5 = lower[0], lower[1], lower[2], lower[3], lower[4]
+    hi1, hi2, hi3, hi4, hi5 = upper[0], upper[1], upper[2], upper[3], upper[4]
     for i in range(m):
-        px, py, pz = s[_PX, i], s[_PY, i], s[_PZ, i]
-        ax, ay, az = s[_AX, i], s[_AY, i], s[_AZ, i]
-        nx, ny, nz = s[_NX, i], s[_NY, i], s[_NZ, i]
+        finite, far, deviation, ax, ay, az, nx, ny, nz = _admit(s, i, approach_only)
+        px, py, pz = s[3, i], s[7, i], s[11, i]
         # Step 2: the arm plane's radial unit vector (c1, s1) towards the tool point (front
         # branch); on the base axis q1 is free: face the approach if it leans, else keep the
         # reference. Then the approach projected into it, a_s = (c1 s234, s1 s234, -c234).
@@ -349,19 +302,48 @@ def _closed_form(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         miss = dist - (a2 + a3) if dist > a2 + a3 else 0.0
         miss = abs(a2 - a3) - dist if dist < abs(a2 - a3) else miss
         c3 = (r_w * r_w + z_w * z_w - a2 * a2 - a3 * a3) / (2.0 * a2 * a3)
-        c3 = min(1.0, max(-1.0, c3))  # elbow stretched or folded: clamp
+        # Elbow stretched or folded: clamp, and snap within FOLD_SNAP (the last digits of c3
+        # decide an elbow angle of up to 1.4e-7 rad there, which moves the tool < 1e-15 m)
+        c3 = 1.0 if c3 > 1.0 - FOLD_SNAP_K else c3
+        c3 = -1.0 if c3 < FOLD_SNAP_K - 1.0 else c3
         s3 = math.sqrt(1.0 - c3 * c3)
+        q3_abs = atan2(s3, c3)
+        beta = atan2(a3 * s3, a2 + a3 * c3)
         # Roll from n: q5 = atan2(n.y4, n.x4), x4 = (c1 c234, s1 c234, s234), y4 = (s1, -c1, 0).
         n_x4 = nx * c1 * c234 + ny * s1 * c234 + nz * s234
         n_y4 = nx * s1 - ny * c1
-        s[_Q3_ABS, i] = atan2(s3, c3)
-        s[_BETA, i] = atan2(a3 * s3, a2 + a3 * c3)
-        s[_Q1, i] = atan2(s1, c1)
-        s[_Q234, i] = atan2(s234, c234)
-        s[_PHI, i] = atan2(z_w, r_w)
-        s[_Q5, i] = s[_Q5_REF, i] if approach_only else atan2(n_y4, n_x4)
-        s[_RW, i] = r_w
-        s[_MISS, i] = miss
+        q1_front = atan2(s1, c1)
+        q234_front = atan2(s234, c234)
+        phi_front = atan2(z_w, r_w)
+        q5_front = s[_Q5_REF, i] if approach_only else atan2(n_y4, n_x4)
+        # The status: 3 not finite, 1 out of reach (far away, or the wrist outside the
+        # annulus), 2 not rigid, 0 solved (IkStatus), in this order of precedence.
+        status = 0.0 if finite == 0.0 else 3.0
+        status = 1.0 if (status == 0.0) & (far > FAR_AWAY_K) else status
+        rigid = deviation <= RIGIDITY_REPAIR_TOLERANCE_K
+        status = 2.0 if (status == 0.0) & (not rigid) else status
+        admitted = status == 0.0
+        status = 1.0 if admitted & (not miss <= REACH_TOLERANCE_K) else status
+        solved = status == 0.0
+        # Step 4: the four branches, wrapped into the limits, with their within-limit flags.
+        # The back branch (plane direction reversed) follows from identities: q1 + pi,
+        # q234 -> -q234, phi -> pi - phi, q5 + pi. q3 is -q3_abs or +q3_abs: two wraps.
+        q3_neg, q3_neg_in = _wrap(-q3_abs, lo3, hi3, tol)
+        q3_pos, q3_pos_in = _wrap(q3_abs, lo3, hi3, tol)
+        q1_back = q1_front - math.pi if q1_front > 0.0 else q1_front + math.pi
+        phi_back = math.pi - phi_front if phi_front >= 0.0 else -math.pi - phi_front
+        q5_back = q5_front - math.pi if q5_front > 0.0 else q5_front + math.pi
+        q1_b, q1_b_in = _wrap(q1_back, lo1, hi1, tol)
+        q1_f, q1_f_in = _wrap(q1_front, lo1, hi1, tol)
+        q5_b, q5_b_in = _wrap(q5_front if approach_only else q5_back, lo5, hi5, tol)
+        q5_f, q5_f_in = _wrap(q5_front, lo5, hi5, tol)
+        common = (beta, q3_abs, q3_neg, q3_neg_in, q3_pos, q3_pos_in, lo2, hi2, lo4, hi4, tol)
+        front = (q1_f, q1_f_in, q5_f, q5_f_in, phi_front, q234_front)
+        back = (q1_b, q1_b_in, q5_b, q5_b_in, phi_back, -q234_front)
+        _branch(s, i, 0, front, r_w >= 0.0, common, solved)  # elbow up: q3 < 0 ahead
+        _branch(s, i, 1, front, r_w < 0.0, common, solved)
+        _branch(s, i, 2, back, -r_w >= 0.0, common, solved)
+        _branch(s, i, 3, back, -r_w < 0.0, common, solved)
         # Step 5: the residual. The reached approach a_s; approach targets: its angle to the
         # target's; full poses: the reached n and o axes (the same for every branch, before any
         # snapping onto a limit) and the angle of R_t^T R_s.
@@ -387,7 +369,12 @@ def _closed_form(  # noqa: PLR0915 (one vectorised pass: every step is a select)
             ax * os0 + ay * os1 + az * os2,
             dot,
         )
-        s[_RESIDUAL, i] = approach_residual if approach_only else frame_residual
+        residual = approach_residual if approach_only else frame_residual
+        s[_STATUS, i] = status
+        s[_RESIDUAL, i] = residual if solved else np.nan
+        # the miss: the wrist's once admitted, the distance beyond the reach when far away
+        s[_MISS, i] = miss if admitted else (far - (a2 + a3 + d5) if status == 1.0 else 0.0)
+        s[_DEVIATION, i] = deviation if (finite == 0.0) & (far <= FAR_AWAY_K) else 0.0
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
@@ -396,31 +383,32 @@ def ik_kernel(T: np.ndarray, q_ref: np.ndarray, params: IkParams, out: IkOutputs
     plane, check the reach, write the four branches, measure the orientation residual.
 
     q_ref (M, 5) with M = 1 or N gives q1 on the base axis and q5 when the roll is free.
-    Blocks of BLOCK poses, three passes each: admit (scalar), the closed form (one
-    vectorised loop), the branches (scalar: the limits); compiled with numpy's error model
-    (a division by zero gives inf or NaN instead of a test per division).
+    Blocks of BLOCK poses: transposed into scratch rows, solved by one vectorised loop, the
+    results transposed back; compiled with numpy's error model (a division by zero gives inf
+    or NaN instead of a test per division).
     """
-    a2, a3, d5 = params.a2, params.a3, params.d5
-    n = T.shape[0]
-    # a constant width: the rows' distance is known at compile time, so the closed form's
-    # loop needs no run-time aliasing checks between them (and vectorises)
+    # a constant width: the rows' distance is known at compile time, so the solving loop
+    # needs no run-time aliasing checks between them (and vectorises)
     s = np.empty((_ROWS, BLOCK))
-    admitted = np.empty(BLOCK, dtype=np.bool_)
-    for start in range(0, n, BLOCK):
-        m = min(BLOCK, n - start)
-        _admit(T, q_ref, start, m, params.approach_only, out, s, admitted)
-        _closed_form(m, a2, a3, d5, params.approach_only, s)
+    for start in range(0, T.shape[0], BLOCK):
+        m = min(BLOCK, T.shape[0] - start)
         for i in range(m):
             k = start + i
-            if not admitted[i]:
-                if out.status[k] == IkStatus.OUT_OF_REACH:
-                    out.miss[k] -= a2 + a3 + d5
-                continue
+            r_k = k if q_ref.shape[0] > 1 else 0
+            for r in range(4):
+                for c in range(4):
+                    s[4 * r + c, i] = T[k, r, c]
+            s[_Q1_REF, i] = q_ref[r_k, 0]
+            s[_PITCH_REF, i] = q_ref[r_k, 1] + q_ref[r_k, 2] + q_ref[r_k, 3]
+            s[_Q5_REF, i] = q_ref[r_k, 4]
+        _solve_block(m, params, s)
+        for i in range(m):
+            k = start + i
+            out.status[k] = np.int8(s[_STATUS, i])
             out.miss[k] = s[_MISS, i]
-            if not out.miss[k] <= REACH_TOLERANCE_K:  # also catches an overflowed miss
-                _mark_unsolved(k, IkStatus.OUT_OF_REACH, out)
-                continue
-            front = (s[_Q1, i], s[_Q234, i], s[_PHI, i], s[_Q5, i], s[_RW, i])
-            _write_branches(k, front, (s[_Q3_ABS, i], s[_BETA, i]), params, out.q, out.within)
+            out.deviation[k] = s[_DEVIATION, i]
             out.residual[k] = s[_RESIDUAL, i]
-            out.status[k] = IkStatus.OK
+            for b in range(4):
+                out.within[k, b] = s[_WITHIN + b, i] != 0.0
+                for j in range(5):
+                    out.q[k, b, j] = s[_Q + 5 * b + j, i]

@@ -183,6 +183,18 @@ def test_stretched_elbow(arm) -> None:
     assert max(s.position_error for s in result.solutions) <= POSE_TOLERANCE
 
 
+@pytest.mark.parametrize("q1_deg", [120.0, 45.0, 10.0, 170.0])
+def test_straight_arm_is_exactly_straight(arm, q1_deg: float) -> None:
+    # the last digits of the elbow cosine decide up to 1e-7 rad there: both elbows are the same
+    # straight branch (q3 = 0 exactly), so a path from the home pose keeps its branch
+    q = np.array([np.radians(q1_deg), 0.0, 0.0, 0.0, 0.0])
+    batch = solve_ik_batch(arm.fk(q))
+    assert batch.q[0, 0, 2] == 0.0 and batch.q[0, 1, 2] == 0.0
+    np.testing.assert_array_equal(batch.q[0, 0], batch.q[0, 1])
+    np.testing.assert_allclose(batch.q[0, 0], q, atol=1e-12)
+    assert batch.within_limits[0, 0] and batch.within_limits[0, 1]
+
+
 def test_folded_elbow(arm) -> None:
     q = np.array([1.0, 0.5, -np.pi, 0.4, 0.2])  # elbow folded back onto the upper arm
     result = arm.ik(arm.fk(q))
