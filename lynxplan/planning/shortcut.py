@@ -462,12 +462,14 @@ def shortcut(
     patience: int = DEFAULT_SHORTCUT_PATIENCE,
     greedy: bool = True,
     partial: float = DEFAULT_PARTIAL_FRACTION,
+    levels: int = FLATTEN_LEVELS,
 ) -> np.ndarray:
     """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path with the
     same ends.
 
-    Deterministic for a given ``seed``; ``iterations`` random cuts are attempted, a fraction
-    ``partial`` of them one-joint (partial) shortcuts.
+    Deterministic for a given ``seed``; one-joint straightening over ``levels`` levels (0:
+    none), then at most ``iterations`` random cuts, a fraction ``partial`` of them one-joint
+    (partial) shortcuts.
     """
     return shortcut_to_goals(
         checker,
@@ -481,6 +483,7 @@ def shortcut(
         patience=patience,
         greedy=greedy,
         partial=partial,
+        levels=levels,
     ).path
 
 
