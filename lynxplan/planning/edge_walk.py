@@ -32,6 +32,7 @@ from lynxplan.planning.validity import (
     STALL_DISTANCE,
     joint_poses_upto,
     pair_bound,
+    pair_bound_below,
     primitive_pose,
     primitive_poses,
 )
@@ -197,16 +198,17 @@ def _walk_start(
     counters[2] += count
     primitive_poses(q_a, model, scratch)
     for p in range(count):
-        if not known:
-            slack[p] = pair_bound(p, model, scratch) - clearance
+        static = 0.0
+        for j in range(dq.shape[0]):
+            static += rates[p, j] * dq[j]
+        if not known:  # the sphere gap alone when it proves the pair for the whole edge
+            enough = clearance + max(static, STALL_DISTANCE) + 1e-12
+            slack[p] = pair_bound_below(p, model, scratch, enough) - clearance
         if slack[p] <= STALL_DISTANCE:
             counters[3] = p
             return False
         where[p] = 0.0
         trend[p] = 0.0
-        static = 0.0
-        for j in range(dq.shape[0]):
-            static += rates[p, j] * dq[j]
         if slack[p] >= static:  # certified to s = 1 by the static bound alone
             reach[p] = np.inf
             continue

@@ -18,7 +18,7 @@ from lynxplan.collision import CollisionWorld, Obstacle
 from lynxplan.exceptions import InputError, PlanningFailed, StateInCollisionError
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
-from lynxplan.planning.shortcut import DEFAULT_SHORTCUT_ITERATIONS, shortcut
+from lynxplan.planning.shortcut import DEFAULT_SHORTCUT_ITERATIONS, shortcut_to_goals
 from lynxplan.planning.space import JointSpace
 from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE, METHODS, TimedPath, time_parameterize
 from lynxplan.planning.validity import STALL_DISTANCE, ValidityChecker
@@ -246,8 +246,15 @@ class Planner:
             settings=settings,
         )
         planned = time.perf_counter()
-        path = shortcut(
-            self.checker, found.path, seed=seed, iterations=self.options.shortcut_iterations
+        path, reached = shortcut_to_goals(
+            self.checker,
+            found.path,
+            goals.configurations[free],
+            found.goal_index,
+            self.space.lower,
+            self.space.upper,
+            seed=seed,
+            iterations=self.options.shortcut_iterations,
         )
         shortened = time.perf_counter()
         report = self.verifier.verify(path, self.options.clearance)
@@ -261,7 +268,7 @@ class Planner:
             rate=self.options.sample_rate,
         )
         done = time.perf_counter()
-        goal_index = free[found.goal_index]
+        goal_index = free[reached]
         stats = PlanningStats(
             nodes=found.nodes,
             iterations=found.iterations,

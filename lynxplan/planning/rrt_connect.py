@@ -7,7 +7,8 @@ gives one root per collision-free IK branch). Each iteration, in the compiled ke
    of the other tree instead);
 2. *extend* the active tree: from its nearest node (linear scan, Euclidean) one step of at most
    ``step`` [rad] towards the sample; the edge is certified by the validity checker's
-   conservative advancement (:func:`lynxplan.planning.edge_walk.edge_fraction`);
+   conservative advancement (:func:`lynxplan.planning.edge_walk.edge_fraction`), after a
+   quick test of its midpoint (a blocked extension is usually blocked there);
 3. *connect* the other tree to the new node: the straight edge from its nearest node is walked
    as far as it is certified; nodes are added every ``step`` along it; reaching the new node
    joins the trees;
@@ -53,8 +54,11 @@ class RrtConnectSettings:
         max_nodes: Node budget of each tree.
     """
 
-    step: float = 0.6
-    goal_bias: float = 0.1
+    # Measured on the AL5 suite (20 seeds): against 0.6 rad / 0.1, a third less search and
+    # shortcut work at the mean for paths as short (the one-joint straightening removes the
+    # wander of longer random steps).
+    step: float = 1.5
+    goal_bias: float = 0.05
     max_nodes: int = 20000
 
 
@@ -150,6 +154,26 @@ def _slacks(
 
 
 @numba.njit(cache=True)
+def _extends(
+    nodes: np.ndarray,
+    slacks: np.ndarray,
+    known: np.ndarray,
+    tree: int,
+    near: int,
+    new: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> bool:
+    """Whether the edge from node ``near`` of ``tree`` to ``new`` (nq,) is certified whole (a
+    blocked extension is usually blocked at its midpoint: that quick test first)."""
+    if not point_is_clear(nodes[tree, near], new, 0.5, model, scratch, clearance):
+        return False
+    start = _slacks(nodes, slacks, known, tree, near, model, scratch, clearance)
+    return bool(edge_fraction_from(nodes[tree, near], new, start, model, scratch, clearance) >= 1.0)
+
+
+@numba.njit(cache=True)
 def rrt_connect_kernel(
     lower: np.ndarray,
     upper: np.ndarray,
@@ -201,8 +225,7 @@ def rrt_connect_kernel(
         if not state_slacks(new, model, scratch, clearance, fresh):
             meta[0] = b
             continue
-        start = _slacks(nodes, slacks, known, a, near, model, scratch, clearance)
-        if edge_fraction_from(nodes[a, near], new, start, model, scratch, clearance) < 1.0:
+        if not _extends(nodes, slacks, known, a, near, new, model, scratch, clearance):
             meta[0] = b
             continue
         added = _add(nodes, parents, counts, a, new, near)

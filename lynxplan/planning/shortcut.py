@@ -1,25 +1,37 @@
 """Path shortcutting and smoothing, compiled with numba; every change is re-validated.
 
-Three passes over a piecewise-linear joint path, all with the planner's validity checker:
+Five passes over a piecewise-linear joint path, all with the planner's validity checker:
 
 1. *Greedy vertex shortcuts*: from the start, each kept waypoint is joined to the farthest
    later waypoint it sees directly (one quick midpoint test, then the certified edge), so the
    random cuts start from a path with few corners.
-2. *Partial shortcutting* (Geraerts & Overmars 2007): pick two random points of the path by arc
-   length (anywhere on its segments, not only at waypoints); if the straight edge between them
-   is certified free (conservative advancement), it replaces the part of the path between them.
-   Cutting between interior points rounds corners off progressively, so this pass also smooths
-   the path towards the taut one; each accepted cut shortens the path (triangle inequality).
-3. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
+2. *Goal switch* (goal sets only: the IK branches or rolls of a pose goal): the end moves to
+   another goal configuration when that shortens the path; the offset between the goals is
+   blended in along the arc length, so a goal that differs in one joint (a roll) turns that
+   joint during the whole motion instead of at the end.
+3. *One-joint straightening*: a *partial* cut (Geraerts & Overmars 2007) moves one joint
+   linearly in the arc length between two points of the path while the others keep their
+   motion; it is tried for every joint over the whole path (:data:`FLATTEN_LEVELS` > 1: then
+   over its halves, ...). RRT-Connect's random samples make joints that matter little for
+   collisions (a wrist roll) wander, and a straight cut of all joints rarely removes that where
+   the others must go around an obstacle: most of the length the random cuts would take many
+   tries to remove goes here in one try per joint.
+4. *Random shortcuts* between two random points of the path by arc length (anywhere on its
+   segments, not only at waypoints): a *full* cut, the straight edge between the points, or
+   (a fraction ``partial`` of the attempts) a partial cut of one joint drawn in proportion to
+   its excess motion (total variation beyond its net displacement). The cuts stop after
+   ``patience`` attempts in a row that changed nothing.
+5. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
 
-The parts of the old path kept around a cut are pieces of certified edges, and the cut itself is
-certified before it is accepted: the path stays valid after every change ("verify after every
-shortcut" — pyroboplan's ``shortcut_path`` does not, and returns paths through obstacles).
+A cut is kept when it shortens the path (a partial cut by at least :data:`MIN_GAIN`) and every
+new edge is certified. The parts of the old path kept around a cut are pieces of certified
+edges: the path stays valid after every change ("verify after every shortcut" — pyroboplan's
+``shortcut_path`` does not, and returns paths through obstacles).
 """
 
 from __future__ import annotations
 
-from typing import Any
+from typing import Any, NamedTuple
 
 import numba
 import numpy as np
@@ -31,7 +43,15 @@ from lynxplan.planning.validity import ValidityChecker, point_is_clear
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
 #: Random cuts stop after this many attempts in a row that changed nothing.
-DEFAULT_SHORTCUT_PATIENCE = 10
+DEFAULT_SHORTCUT_PATIENCE = 5
+#: Fraction of the random attempts that are partial (one-joint) shortcuts.
+DEFAULT_PARTIAL_FRACTION = 0.5
+#: Joints that move less than this beyond their net displacement get no partial shortcut, [rad].
+WANDER_TOLERANCE = 1e-3
+#: A partial shortcut must shorten the path by at least this, in [rad].
+MIN_GAIN = 1e-3
+#: Levels of the one-joint straightening pass (:func:`_flatten`): whole path, halves, ...
+FLATTEN_LEVELS = 1
 #: Points closer than this in joint space are merged, in [rad].
 _MERGE_DISTANCE = 1e-9
 
@@ -82,6 +102,246 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
 
 
 @numba.njit(cache=True)
+def _segments_free(
+    points: np.ndarray, size: int, model: Any, scratch: Any, clearance: float
+) -> bool:
+    """Whether every straight edge between consecutive rows of points[:size] is certified
+    (quick midpoint tests of all edges first: a blocked edge is usually blocked there)."""
+    for k in range(size - 1):
+        if not point_is_clear(points[k], points[k + 1], 0.5, model, scratch, clearance):
+            return False
+    for k in range(size - 1):
+        if not edge_is_free(points[k], points[k + 1], model, scratch, clearance):
+            return False
+    return True
+
+
+@numba.njit(cache=True)
+def _full(
+    path: np.ndarray,
+    count: int,
+    cumulative: np.ndarray,
+    u1: float,
+    u2: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    work: np.ndarray,
+    piece: np.ndarray,
+) -> int:
+    """Full shortcut: the straight edge between the points at arc lengths u1 < u2 replaces the
+    path between them when it is certified (in place); returns the new count, or 0 when
+    nothing changed."""
+    first, second = piece[0], piece[1]
+    i1 = _point_at(path, cumulative, count, u1, first)
+    i2 = _point_at(path, cumulative, count, u2, second)
+    if i1 == i2 or count + 2 > path.shape[0]:
+        return 0
+    if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
+        not edge_is_free(first, second, model, scratch, clearance)
+    ):
+        return 0
+    # New path: path[0..i1], first, second, path[i2+1..count-1].
+    size = 0
+    for k in range(i1 + 1):
+        work[size] = path[k]
+        size += 1
+    if _distance(first, work[size - 1]) > _MERGE_DISTANCE:
+        work[size] = first
+        size += 1
+    if _distance(second, path[i2 + 1]) > _MERGE_DISTANCE:
+        work[size] = second
+        size += 1
+    for k in range(i2 + 1, count):
+        work[size] = path[k]
+        size += 1
+    for k in range(size):
+        path[k] = work[k]
+    return size
+
+
+@numba.njit(cache=True)
+def _wandering_joint(path: np.ndarray, count: int, r: float) -> int:
+    """A joint drawn with probability proportional to its excess motion along path[:count]
+    (total variation minus net displacement, in [rad]; r uniform in [0, 1)), or -1 when no
+    joint moves more than :data:`WANDER_TOLERANCE` beyond its net displacement."""
+    nq: int = path.shape[1]
+    excess = np.empty(nq)
+    total = 0.0
+    for j in range(nq):
+        variation = 0.0
+        for k in range(1, count):
+            variation += abs(path[k, j] - path[k - 1, j])
+        excess[j] = max(0.0, variation - abs(path[count - 1, j] - path[0, j]) - WANDER_TOLERANCE)
+        total += excess[j]
+    if total <= 0.0:
+        return -1
+    target = r * total
+    for j in range(nq):
+        target -= excess[j]
+        if target < 0.0:
+            return j
+    return nq - 1
+
+
+@numba.njit(cache=True)
+def _partial(
+    path: np.ndarray,
+    count: int,
+    cumulative: np.ndarray,
+    u1: float,
+    u2: float,
+    joint: int,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    work: np.ndarray,
+    piece: np.ndarray,
+) -> int:
+    """Partial shortcut of one joint (Geraerts & Overmars 2007): between the points at arc
+    lengths u1 < u2, that joint moves linearly in the arc length while the others keep their
+    motion. Applied in place when it shortens the path and every new edge is certified; returns
+    the new count, or 0 when nothing changed."""
+    first, second = piece[0], piece[1]
+    i1 = _point_at(path, cumulative, count, u1, first)
+    i2 = _point_at(path, cumulative, count, u2, second)
+    if i1 == i2 or count + 2 > path.shape[0]:
+        return 0
+    # piece: first, waypoints i1+1..i2 with the joint re-interpolated, second.
+    size = 1
+    for k in range(i1 + 1, i2 + 1):
+        piece[size + 1, :] = path[k]
+        w = (cumulative[k] - u1) / (u2 - u1)
+        piece[size + 1, joint] = first[joint] + w * (second[joint] - first[joint])
+        size += 1
+    # rows: 0 first, 2..size waypoints, then second; move second behind them
+    piece[size + 1, :] = second
+    piece[1, :] = piece[0]
+    points = piece[1 : size + 2]
+    size += 1
+    length = 0.0
+    for k in range(size - 1):
+        length += _distance(points[k], points[k + 1])
+    if length >= (u2 - u1) - MIN_GAIN:
+        return 0
+    if not _segments_free(points, size, model, scratch, clearance):
+        return 0
+    total = 0
+    for k in range(i1 + 1):
+        work[total] = path[k]
+        total += 1
+    start = 0 if _distance(points[0], work[total - 1]) > _MERGE_DISTANCE else 1
+    for k in range(start, size - 1):
+        work[total] = points[k]
+        total += 1
+    if _distance(points[size - 1], path[i2 + 1]) > _MERGE_DISTANCE:
+        work[total] = points[size - 1]
+        total += 1
+    for k in range(i2 + 1, count):
+        work[total] = path[k]
+        total += 1
+    for k in range(total):
+        path[k] = work[k]
+    return total
+
+
+@numba.njit(cache=True)
+def _flatten(
+    path: np.ndarray,
+    count: int,
+    cumulative: np.ndarray,
+    levels: int,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    work: np.ndarray,
+    piece: np.ndarray,
+) -> int:
+    """Partial shortcuts of each joint over the whole path, then over its halves, ... (``levels``
+    levels: 2^level equal parts of the arc length at level ``level``), in place on
+    path[:count]; returns the new count. A joint that wanders over the whole path (a wrist roll
+    that turns away and back) is straightened in one try instead of many random ones."""
+    for level in range(levels):
+        parts = 2**level
+        for joint in range(path.shape[1]):
+            for part in range(parts):
+                if count < 3:
+                    return count
+                cumulative[0] = 0.0
+                for k in range(1, count):
+                    cumulative[k] = cumulative[k - 1] + _distance(path[k - 1], path[k])
+                total = cumulative[count - 1]
+                size = _partial(
+                    path,
+                    count,
+                    cumulative,
+                    total * part / parts,
+                    total * (part + 1) / parts,
+                    joint,
+                    model,
+                    scratch,
+                    clearance,
+                    work,
+                    piece,
+                )
+                if size > 0:
+                    count = size
+    return count
+
+
+@numba.njit(cache=True)
+def _switch_goal(
+    path: np.ndarray,
+    count: int,
+    goals: np.ndarray,
+    current: int,
+    bounds: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    piece: np.ndarray,
+) -> int:
+    """Move the end of path[:count] to another goal configuration when that shortens it: the
+    offset to the new goal is blended in along the arc length (every waypoint moves by its
+    fraction of the length), so a goal differing in one joint (another roll of an approach
+    goal) turns that joint during the whole motion. The nearest goals are tried first; the
+    new path must stay within the joint limits bounds (2, nq) and every edge be certified.
+    Returns the goal index reached (``current`` if unchanged)."""
+    nq = path.shape[1]
+    old = 0.0
+    for k in range(1, count):
+        old += _distance(path[k - 1], path[k])
+    if old <= 0.0:
+        return current
+    offsets = np.empty(goals.shape[0])
+    for g in range(goals.shape[0]):
+        offsets[g] = _distance(goals[g], goals[current])
+    for g in np.argsort(offsets):
+        if g == current:
+            continue
+        along = 0.0
+        inside = True
+        piece[0] = path[0]
+        for k in range(1, count):
+            along += _distance(path[k - 1], path[k])
+            for j in range(nq):
+                value = path[k, j] + along / old * (goals[g, j] - goals[current, j])
+                inside = inside and bounds[0, j] <= value <= bounds[1, j]
+                piece[k, j] = value
+        piece[count - 1] = goals[g]
+        length = 0.0
+        for k in range(1, count):
+            length += _distance(piece[k - 1], piece[k])
+        if not inside or length >= old - MIN_GAIN:
+            continue
+        if _segments_free(piece, count, model, scratch, clearance):
+            for k in range(count):
+                path[k] = piece[k]
+            return int(g)
+    return current
+
+
+@numba.njit(cache=True)
 def shortcut_kernel(
     path: np.ndarray,
     count: int,
@@ -93,19 +353,32 @@ def shortcut_kernel(
     work: np.ndarray,
     patience: int,
     greedy: bool,
+    partial: float,
+    goals: np.ndarray,
+    goal: np.ndarray,
+    bounds: np.ndarray,
+    levels: int,
 ) -> int:
-    """Greedy vertex shortcuts (if ``greedy``), partial shortcuts then vertex pruning, in place on
-    path[:count]; returns the new count.
+    """Greedy vertex shortcuts (if ``greedy``), goal switch, one-joint straightening over
+    ``levels`` levels, random full and partial cuts (a fraction ``partial`` of the attempts)
+    then vertex pruning, in place on path[:count]; returns the new count.
 
-    path: (capacity, nq) with capacity >= count + 2 * iterations; work: same shape. The cuts stop
-    early after ``patience`` attempts in a row that changed nothing.
+    path: (capacity, nq); a cut adds at most two rows, and none is made once the capacity is
+    reached (count + 2 * (iterations + nq * (2^levels - 1)) suffices); work: same shape. The
+    cuts stop early after ``patience`` attempts in a row that changed nothing. goals: (K, nq) goal
+    configurations; goal: (1,) the index of the one path[count - 1] is, updated; bounds:
+    (2, nq) joint limits, in [rad].
     """
     nq = path.shape[1]
     cumulative = np.empty(path.shape[0])
-    first = np.empty(nq)
-    second = np.empty(nq)
+    piece = np.empty((path.shape[0] + 2, nq))
     if greedy:
         count = _greedy(path, count, model, scratch, clearance)
+    if goals.shape[0] > 1 and count >= 2:
+        goal[0] = _switch_goal(
+            path, count, goals, goal[0], bounds, model, scratch, clearance, piece
+        )
+    count = _flatten(path, count, cumulative, levels, model, scratch, clearance, work, piece)
     idle = 0
     for _ in range(iterations):
         if count < 3 or idle >= patience:
@@ -119,35 +392,24 @@ def shortcut_kernel(
         u2 = _rng.uniform(state) * total
         if u1 > u2:
             u1, u2 = u2, u1
-        i1 = _point_at(path, cumulative, count, u1, first)
-        i2 = _point_at(path, cumulative, count, u2, second)
-        if i1 == i2:
+        if _rng.uniform(state) < partial:
+            joint = _wandering_joint(path, count, _rng.uniform(state))
+            if joint < 0:
+                continue
+            size = _partial(
+                path, count, cumulative, u1, u2, joint, model, scratch, clearance, work, piece
+            )
+            if size > 0:
+                count, idle = size, 0
             continue
-        if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
-            not edge_is_free(first, second, model, scratch, clearance)
-        ):
-            continue
-        idle = 0
-        # New path: path[0..i1], first, second, path[i2+1..count-1].
-        size = 0
-        for k in range(i1 + 1):
-            work[size] = path[k]
-            size += 1
-        if _distance(first, work[size - 1]) > _MERGE_DISTANCE:
-            work[size] = first
-            size += 1
-        if _distance(second, path[i2 + 1]) > _MERGE_DISTANCE:
-            work[size] = second
-            size += 1
-        for k in range(i2 + 1, count):
-            work[size] = path[k]
-            size += 1
-        for k in range(size):
-            path[k] = work[k]
-        count = size
+        size = _full(path, count, cumulative, u1, u2, model, scratch, clearance, work, piece)
+        if size > 0:
+            count, idle = size, 0
     k = 1
     while k < count - 1:
-        if edge_is_free(path[k - 1], path[k + 1], model, scratch, clearance):
+        if point_is_clear(
+            path[k - 1], path[k + 1], 0.5, model, scratch, clearance
+        ) and edge_is_free(path[k - 1], path[k + 1], model, scratch, clearance):
             for m in range(k, count - 1):
                 path[m] = path[m + 1]
             count -= 1
@@ -199,17 +461,69 @@ def shortcut(
     iterations: int = DEFAULT_SHORTCUT_ITERATIONS,
     patience: int = DEFAULT_SHORTCUT_PATIENCE,
     greedy: bool = True,
+    partial: float = DEFAULT_PARTIAL_FRACTION,
+    levels: int = FLATTEN_LEVELS,
 ) -> np.ndarray:
-    """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path.
+    """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path with the
+    same ends.
 
-    Deterministic for a given ``seed``; ``iterations`` random cuts are attempted.
+    Deterministic for a given ``seed``; one-joint straightening over ``levels`` levels (0:
+    none), then at most ``iterations`` random cuts, a fraction ``partial`` of them one-joint
+    (partial) shortcuts.
+    """
+    return shortcut_to_goals(
+        checker,
+        path,
+        path[-1:],
+        0,
+        np.full(path.shape[1], -np.inf),
+        np.full(path.shape[1], np.inf),
+        seed=seed,
+        iterations=iterations,
+        patience=patience,
+        greedy=greedy,
+        partial=partial,
+        levels=levels,
+    ).path
+
+
+class ShortcutResult(NamedTuple):
+    """A shortcut path and the goal configuration it ends at."""
+
+    #: Waypoints, shape (M, nq), in [rad].
+    path: np.ndarray
+    #: Index of its last waypoint among the goal configurations.
+    goal_index: int
+
+
+def shortcut_to_goals(
+    checker: ValidityChecker,
+    path: np.ndarray,
+    goals: np.ndarray,
+    goal_index: int,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    *,
+    seed: int,
+    iterations: int = DEFAULT_SHORTCUT_ITERATIONS,
+    patience: int = DEFAULT_SHORTCUT_PATIENCE,
+    greedy: bool = True,
+    partial: float = DEFAULT_PARTIAL_FRACTION,
+    levels: int = FLATTEN_LEVELS,
+) -> ShortcutResult:
+    """:func:`shortcut` of a path (N, nq) that ends at ``goals[goal_index]`` (goals: (K, nq),
+    in [rad], every one valid): the path may move its end to another goal configuration when
+    that shortens it (another IK branch or roll of a pose goal), within the joint limits
+    ``lower``, ``upper`` (nq,), in [rad].
     """
     path = merge_collinear(path)
     count = len(path)
-    capacity = count + 2 * iterations + 2
+    capacity = count + 2 * (iterations + path.shape[1] * (2**levels - 1)) + 2
     buffer = np.zeros((capacity, path.shape[1]))
     buffer[:count] = path
     work = np.zeros_like(buffer)
+    goal = np.array([goal_index], dtype=np.int64)
+    bounds = np.vstack([lower, upper]).astype(float)
     # A stream of its own: the planner's draws and the shortcutter's never overlap.
     state = _rng.seed_state(seed ^ 0x5DEECE66D)
     count = shortcut_kernel(
@@ -223,6 +537,10 @@ def shortcut(
         work,
         patience,
         greedy,
+        partial,
+        np.ascontiguousarray(goals, dtype=float),
+        goal,
+        bounds,
+        levels,
     )
-    result: np.ndarray = buffer[:count].copy()
-    return result
+    return ShortcutResult(buffer[:count].copy(), int(goal[0]))

@@ -228,15 +228,24 @@ def centre_gap(pa: np.ndarray, ra: float, pb: np.ndarray, rb: float) -> float:
 @numba.njit(cache=True, inline="always")
 def pair_bound(p: int, model: Any, scratch: Any) -> float:
     """Lower bound of pair p's distance at the poses in scratch[3], in [m]."""
+    return pair_bound_below(p, model, scratch, SAT_SKIP_DISTANCE)
+
+
+@numba.njit(cache=True, inline="always")
+def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
+    """:func:`pair_bound` where only whether it reaches ``enough`` [m] matters above that: the
+    bounding-sphere gap when it is at least ``min(enough, SAT_SKIP_DISTANCE)`` (no separating
+    axis test), else the tight bound. Either is a lower bound of the distance."""
     prim_half, prim_radius, pairs = model[6], model[7], model[8]
     kinds, centres, poses_b, obstacle_half, obstacle_radius = model[10:15]
     poses = scratch[3]
     a, b = pairs[p, 0], pairs[p, 1]
     pa = poses[a]
+    skip = min(enough, SAT_SKIP_DISTANCE)
     if pairs[p, 2] == 1:
         pb = poses[b]
         gap = centre_gap(pa, prim_radius[a], pb, prim_radius[b])
-        if gap < SAT_SKIP_DISTANCE:
+        if gap < skip:
             sat = _separating_axis_gap(pa, prim_half[a], pb, prim_half[b], scratch[8])
             gap = max(gap, sat)
         return float(gap)
@@ -245,7 +254,7 @@ def pair_bound(p: int, model: Any, scratch: Any) -> float:
     c = centres[b]
     dx, dy, dz = c[0] - pa[0, 3], c[1] - pa[1, 3], c[2] - pa[2, 3]
     gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - obstacle_radius[b]
-    if gap < SAT_SKIP_DISTANCE:
+    if gap < skip:
         sat = _separating_axis_gap(pa, prim_half[a], poses_b[b], obstacle_half[b], scratch[8])
         gap = max(gap, sat)
     return float(gap)
@@ -284,10 +293,10 @@ def point_is_clear(
     primitive_poses(q, model, scratch)
     count, last = model[8].shape[0], scratch[9][3]
     threshold = clearance + STALL_DISTANCE
-    if last < count and pair_bound(last, model, scratch) <= threshold:
+    if last < count and pair_bound_below(last, model, scratch, threshold) <= threshold:
         return False
     for p in range(count):
-        if p != last and pair_bound(p, model, scratch) <= threshold:
+        if p != last and pair_bound_below(p, model, scratch, threshold) <= threshold:
             scratch[9][3] = p
             return False
     return True

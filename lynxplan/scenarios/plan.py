@@ -14,8 +14,8 @@ Example (``scenarios/planning/`` holds the problem suite)::
       seed: 0                                   # same seed -> bit-identical trajectory
       time_limit: 1.0                           # [s]
       clearance: 0.002                          # required clearance, file's length unit
-      step: 34                                  # RRT-Connect step, file's angle unit
-      goal_bias: 0.1
+      step: 86                                  # RRT-Connect step, file's angle unit
+      goal_bias: 0.05
       max_nodes: 20000                          # per tree
       shortcut_iterations: 60
       timing: ruckig                            # ruckig | lspb | toppra
@@ -87,7 +87,9 @@ class PlannerEntry(StrictModel):
         None, description="Required clearance, file's length unit (default 2 mm)."
     )
     step: Positive | None = Field(None, description="RRT-Connect step, file's angle unit.")
-    goal_bias: Annotated[float, Field(ge=0, lt=1)] = 0.1
+    goal_bias: Annotated[float, Field(ge=0, lt=1)] | None = Field(
+        None, description="Probability of sampling the other tree's root (default 0.05)."
+    )
     max_nodes: int = Field(20000, ge=2, le=10_000_000, description="Node budget per tree.")
     shortcut_iterations: int = Field(60, ge=0, le=100_000)
     timing: Literal["ruckig", "lspb", "toppra"] = "ruckig"
@@ -180,7 +182,6 @@ def planner_options(scenario: Input) -> Any:
     length, angle = length_factor(scenario.units.length), angle_factor(scenario.units.angle)
     entry = scenario.planner
     values: dict[str, Any] = {
-        "goal_bias": entry.goal_bias,
         "max_nodes": entry.max_nodes,
         "shortcut_iterations": entry.shortcut_iterations,
         "timing": entry.timing,
@@ -190,6 +191,8 @@ def planner_options(scenario: Input) -> Any:
         values["clearance"] = entry.clearance * length
     if entry.step is not None:
         values["step"] = entry.step * angle
+    if entry.goal_bias is not None:
+        values["goal_bias"] = entry.goal_bias
     for key in ("acceleration", "jerk"):
         value = getattr(entry, key)
         if isinstance(value, list):
