@@ -35,12 +35,17 @@ from typing import Any
 import numba
 import numpy as np
 
-from lynxplan.planning.edge_walk import STEP_GROWTH, lever_arms, reach_step, span_motion
+from lynxplan.planning.edge_walk import (
+    STEP_GROWTH,
+    lever_arms,
+    pose_pair_at,
+    reach_step,
+    span_motion,
+)
 from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
 from lynxplan.planning.validity import (
     centre_gap,
     joint_poses,
-    joint_poses_upto,
     pair_bound,
     primitive_pose,
     primitive_poses,
@@ -108,17 +113,7 @@ def _bound_at(
 ) -> float:
     """Pair p's bound at q_a + s (q_b - q_a): its sphere gap if ``sphere`` else the tight one;
     its lever arms -> scratch[13][side]."""
-    q, pairs, joint_of = scratch[7], model[8], model[4]
-    for j in range(q_a.shape[0]):
-        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-    last = joint_of[pairs[p, 0]]
-    if pairs[p, 2] == 1:
-        last = max(last, joint_of[pairs[p, 1]])
-    joint_poses_upto(q, model, scratch, last)  # later joints move neither primitive
-    primitive_pose(pairs[p, 0], model, scratch)
-    if pairs[p, 2] == 1:
-        primitive_pose(pairs[p, 1], model, scratch)
-    lever_arms(p, scratch[0], scratch[3], model, scratch[13][side])
+    pose_pair_at(q_a, q_b, s, p, model, scratch, side)
     if sphere:
         return float(sphere_gap(p, model, scratch))
     return float(pair_bound(p, model, scratch))

@@ -107,10 +107,11 @@ def span_motion(p: int, ds: float, model: Any, scratch: Any) -> float:
 
 
 @numba.njit(cache=True, inline="always")
-def _pair_at(
+def pose_pair_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
-) -> float:
-    """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
+) -> None:
+    """Pair p's primitives posed at q_a + s (q_b - q_a) (joints beyond them left alone: they
+    move neither); its lever arms -> scratch[13][side]."""
     q, pairs, joint_of = scratch[7], model[8], model[4]
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
@@ -121,9 +122,17 @@ def _pair_at(
     primitive_pose(pairs[p, 0], model, scratch)
     if pairs[p, 2] == 1:
         primitive_pose(pairs[p, 1], model, scratch)
+    lever_arms(p, scratch[0], scratch[3], model, scratch[13][side])
+
+
+@numba.njit(cache=True, inline="always")
+def _pair_at(
+    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
+) -> float:
+    """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
+    pose_pair_at(q_a, q_b, s, p, model, scratch, side)
     scratch[9][1] += 1
     scratch[9][2] += 1
-    lever_arms(p, scratch[0], scratch[3], model, scratch[13][side])
     return float(pair_bound(p, model, scratch))
 
 

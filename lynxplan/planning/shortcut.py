@@ -117,6 +117,36 @@ def _segments_free(
 
 
 @numba.njit(cache=True)
+def _splice(
+    path: np.ndarray,
+    count: int,
+    i1: int,
+    i2: int,
+    points: np.ndarray,
+    size: int,
+    work: np.ndarray,
+) -> int:
+    """path[:count] with its waypoints i1+1..i2 replaced by points[:size], in place (work:
+    scratch rows); an end point within _MERGE_DISTANCE of its neighbour (path[i1], path[i2+1])
+    is left out. Returns the new count."""
+    total = 0
+    for k in range(i1 + 1):
+        work[total] = path[k]
+        total += 1
+    start = 0 if _distance(points[0], path[i1]) > _MERGE_DISTANCE else 1
+    stop = size if _distance(points[size - 1], path[i2 + 1]) > _MERGE_DISTANCE else size - 1
+    for k in range(start, stop):
+        work[total] = points[k]
+        total += 1
+    for k in range(i2 + 1, count):
+        work[total] = path[k]
+        total += 1
+    for k in range(total):
+        path[k] = work[k]
+    return total
+
+
+@numba.njit(cache=True)
 def _full(
     path: np.ndarray,
     count: int,
@@ -141,23 +171,7 @@ def _full(
         not edge_is_free(first, second, model, scratch, clearance)
     ):
         return 0
-    # New path: path[0..i1], first, second, path[i2+1..count-1].
-    size = 0
-    for k in range(i1 + 1):
-        work[size] = path[k]
-        size += 1
-    if _distance(first, work[size - 1]) > _MERGE_DISTANCE:
-        work[size] = first
-        size += 1
-    if _distance(second, path[i2 + 1]) > _MERGE_DISTANCE:
-        work[size] = second
-        size += 1
-    for k in range(i2 + 1, count):
-        work[size] = path[k]
-        size += 1
-    for k in range(size):
-        path[k] = work[k]
-    return size
+    return _splice(path, count, i1, i2, piece, 2, work)  # path[..i1], first, second, path[i2+1..]
 
 
 @numba.njit(cache=True)
@@ -226,23 +240,7 @@ def _partial(
         return 0
     if not _segments_free(points, size, model, scratch, clearance):
         return 0
-    total = 0
-    for k in range(i1 + 1):
-        work[total] = path[k]
-        total += 1
-    start = 0 if _distance(points[0], work[total - 1]) > _MERGE_DISTANCE else 1
-    for k in range(start, size - 1):
-        work[total] = points[k]
-        total += 1
-    if _distance(points[size - 1], path[i2 + 1]) > _MERGE_DISTANCE:
-        work[total] = points[size - 1]
-        total += 1
-    for k in range(i2 + 1, count):
-        work[total] = path[k]
-        total += 1
-    for k in range(total):
-        path[k] = work[k]
-    return total
+    return _splice(path, count, i1, i2, points, size, work)
 
 
 @numba.njit(cache=True)
