@@ -109,19 +109,19 @@ def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
-    """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside."""
-    if lo <= x <= hi:
-        return x, True
-    turns = math.floor((x - lo) / TWO_PI)  # floor is one instruction; % calls fmod
-    y = x - turns * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
-    if y <= hi:
-        return y, True
-    if y <= hi + tol:
-        return hi, True
-    if y >= lo + TWO_PI - tol:
-        return lo, True
-    above, below = y - hi, lo + TWO_PI - y
-    return (y, False) if above <= below else (y - TWO_PI, False)
+    """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside.
+
+    By selects, no branch: array loops over it vectorise (branches outside the limits are
+    common and unpredictable in scalar loops too)."""
+    inside = (lo <= x) & (x <= hi)
+    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
+    snap_hi = y <= hi + tol
+    snap_lo = y >= lo + TWO_PI - tol
+    nearest = y if y - hi <= lo + TWO_PI - y else y - TWO_PI
+    out = lo if snap_lo else nearest
+    out = hi if snap_hi else out
+    out = y if y <= hi else out
+    return (x if inside else out), inside | snap_hi | snap_lo
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -167,20 +167,6 @@ def _angle_between_frames(
         _dot3(a_t, o_s),
         _dot3(a_t, a_s),
     )
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _wrap(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
-    """:func:`wrap_into_limits` by selects (no branch: array loops over it vectorise)."""
-    inside = (lo <= x) & (x <= hi)
-    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
-    snap_hi = y <= hi + tol
-    snap_lo = y >= lo + TWO_PI - tol
-    nearest = y if y - hi <= lo + TWO_PI - y else y - TWO_PI
-    out = lo if snap_lo else nearest
-    out = hi if snap_hi else out
-    out = y if y <= hi else out
-    return (x if inside else out), inside | snap_hi | snap_lo
 
 
 #: Poses per block: the kernel transposes a block into scratch rows (one row a quantity),
@@ -250,8 +236,8 @@ def _branch(
     beta, q3_abs, q3_neg, q3_neg_in, q3_pos, q3_pos_in, lo2, hi2, lo4, hi4, tol = common
     q2 = phi + beta if negative else phi - beta
     q4 = q234 - q2 - (-q3_abs if negative else q3_abs)
-    q2w, q2_in = _wrap(q2, lo2, hi2, tol)
-    q4w, q4_in = _wrap(q4, lo4, hi4, tol)
+    q2w, q2_in = wrap_into_limits(q2, lo2, hi2, tol)
+    q4w, q4_in = wrap_into_limits(q4, lo4, hi4, tol)
     row = _Q + 5 * b
     s[row, i] = q1 if solved else np.nan
     s[row + 1, i] = q2w if solved else np.nan
@@ -328,15 +314,15 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         # Step 4: the four branches, wrapped into the limits, with their within-limit flags.
         # The back branch (plane direction reversed) follows from identities: q1 + pi,
         # q234 -> -q234, phi -> pi - phi, q5 + pi. q3 is -q3_abs or +q3_abs: two wraps.
-        q3_neg, q3_neg_in = _wrap(-q3_abs, lo3, hi3, tol)
-        q3_pos, q3_pos_in = _wrap(q3_abs, lo3, hi3, tol)
+        q3_neg, q3_neg_in = wrap_into_limits(-q3_abs, lo3, hi3, tol)
+        q3_pos, q3_pos_in = wrap_into_limits(q3_abs, lo3, hi3, tol)
         q1_back = q1_front - math.pi if q1_front > 0.0 else q1_front + math.pi
         phi_back = math.pi - phi_front if phi_front >= 0.0 else -math.pi - phi_front
         q5_back = q5_front - math.pi if q5_front > 0.0 else q5_front + math.pi
-        q1_b, q1_b_in = _wrap(q1_back, lo1, hi1, tol)
-        q1_f, q1_f_in = _wrap(q1_front, lo1, hi1, tol)
-        q5_b, q5_b_in = _wrap(q5_front if approach_only else q5_back, lo5, hi5, tol)
-        q5_f, q5_f_in = _wrap(q5_front, lo5, hi5, tol)
+        q1_b, q1_b_in = wrap_into_limits(q1_back, lo1, hi1, tol)
+        q1_f, q1_f_in = wrap_into_limits(q1_front, lo1, hi1, tol)
+        q5_b, q5_b_in = wrap_into_limits(q5_front if approach_only else q5_back, lo5, hi5, tol)
+        q5_f, q5_f_in = wrap_into_limits(q5_front, lo5, hi5, tol)
         common = (beta, q3_abs, q3_neg, q3_neg_in, q3_pos, q3_pos_in, lo2, hi2, lo4, hi4, tol)
         front = (q1_f, q1_f_in, q5_f, q5_f_in, phi_front, q234_front)
         back = (q1_b, q1_b_in, q5_b, q5_b_in, phi_back, -q234_front)
