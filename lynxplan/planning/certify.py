@@ -43,6 +43,7 @@ from lynxplan.planning.edge_walk import (
     span_motion,
 )
 from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
+from lynxplan.planning.lanes import all_pair_bounds
 from lynxplan.planning.validity import (
     centre_gap,
     joint_poses,
@@ -141,7 +142,7 @@ def _end_bounds(
     _poses_at(q_a, q_b, end, model, scratch)
     for p in range(model[8].shape[0]):
         out[0, p] = sphere_gap(p, model, scratch)
-        out[1, p] = pair_bound(p, model, scratch)
+    all_pair_bounds(model, scratch[3], out[1])
 
 
 @numba.njit(cache=True)
@@ -343,5 +344,4 @@ def waypoint_bounds(
     for n in range(path.shape[0]):
         primitive_poses(path[n], model, scratch)
         poses[n] = scratch[3]
-        for p in range(model[8].shape[0]):
-            bounds[n, p] = pair_bound(p, model, scratch)
+        all_pair_bounds(model, scratch[3], bounds[n])

@@ -28,11 +28,20 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.planning.kernel_model import LANES
+from lynxplan.planning.lanes import (
+    MAX_JOINTS,
+    OUT_ARMS,
+    OUT_BOUND,
+    OUT_S,
+    all_pair_bounds,
+    pair_along,
+)
 from lynxplan.planning.validity import (
     STALL_DISTANCE,
+    first_below,
     joint_poses_upto,
     pair_bound,
-    pair_bound_below,
     primitive_pose,
     primitive_poses,
 )
@@ -140,6 +149,11 @@ def _pair_at(
 STEP_GROWTH = 1.9
 #: ... and never more than this many.
 MAX_GROWTH = 4.0
+#: The points of a vectorised run are this many predicted one-sided steps apart (below
+#: STEP_GROWTH: a run skips points that prove too close, but stops at one too far).
+LANE_GROWTH = 1.2
+#: ... predicting a slack never below this fraction of the slack at the run's start.
+LANE_FLOOR = 0.05
 
 
 @numba.njit(cache=True)
@@ -147,20 +161,12 @@ def state_slacks(
     q: np.ndarray, model: Any, scratch: Any, clearance: float, out: np.ndarray
 ) -> bool:
     """Every pair's bound minus the clearance at q (nq,) -> out (P,), in [m]; whether all exceed
-    :data:`STALL_DISTANCE`. Stops at the first pair that does not (out is then partial), trying
-    first the pair that failed last (scratch[9][3])."""
-    primitive_poses(q, model, scratch)
-    count, last = model[8].shape[0], scratch[9][3]
-    if last < count:
-        out[last] = pair_bound(last, model, scratch) - clearance
-        if out[last] <= STALL_DISTANCE:
-            return False
-    for p in range(count):
-        if p != last:
-            out[p] = pair_bound(p, model, scratch) - clearance
-            if out[p] <= STALL_DISTANCE:
-                scratch[9][3] = p
-                return False
+    :data:`STALL_DISTANCE` (out is only complete when they do). The pair that failed last
+    (scratch[9][3]) is tried alone first (:func:`lynxplan.planning.validity.first_below`)."""
+    if first_below(q, model, scratch, clearance + STALL_DISTANCE, out) != -1:
+        return False
+    for p in range(out.shape[0]):
+        out[p] -= clearance
     return True
 
 
@@ -172,7 +178,7 @@ def edge_fraction(
 
     Returns -1 if q_a itself is not valid (:func:`edge_walk`).
     """
-    return edge_walk(q_a, q_b, model, scratch, clearance, False)
+    return edge_walk(q_a, q_b, model, scratch, clearance, False, 0)
 
 
 @numba.njit(cache=True)
@@ -180,58 +186,238 @@ def edge_fraction_from(
     q_a: np.ndarray,
     q_b: np.ndarray,
     slack_a: np.ndarray,
+    slack_b: np.ndarray,
+    midpoint: bool,
     model: Any,
     scratch: Any,
     clearance: float,
 ) -> float:
-    """:func:`edge_fraction` with the pairs' slacks at q_a already known (slack_a (P,), in [m],
-    from :func:`state_slacks` at exactly q_a): a tree node's, computed once."""
+    """:func:`edge_fraction` with the pairs' slacks at q_a and q_b already known (slack_a,
+    slack_b (P,), in [m], from :func:`state_slacks` at exactly q_a and q_b: tree nodes',
+    computed once); with ``midpoint``, scratch[18] holds every pair's bound at the edge's
+    midpoint (a quick test :func:`lynxplan.planning.validity.point_is_clear` at s = 0.5 of
+    this edge that passed, just before)."""
     scratch[4][:] = slack_a
-    return edge_walk(q_a, q_b, model, scratch, clearance, True)
+    scratch[19][:] = slack_b
+    grid = END_KNOWN | (MIDPOINT if midpoint else 0)
+    return edge_walk(q_a, q_b, model, scratch, clearance, True, grid)
+
+
+@numba.njit(cache=True)
+def edge_is_free_after_midpoint(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
+) -> bool:
+    """:func:`edge_is_free` right after a quick test of its midpoint passed
+    (:func:`lynxplan.planning.validity.point_is_clear` at s = 0.5: its bounds are in
+    scratch[18])."""
+    return edge_walk(q_a, q_b, model, scratch, clearance, False, MIDPOINT) >= 1.0
+
+
+#: Flags of :func:`edge_walk`: the pairs' slacks at the edge's end are in scratch[19]; their
+#: bounds at its midpoint are in scratch[18].
+END_KNOWN, MIDPOINT = 1, 2
 
 
 @numba.njit(cache=True, inline="always")
 def _walk_start(
-    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float, known: bool
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    known: bool,
+    grid: int,
 ) -> bool:
-    """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and first
-    one-sided reach; False when a pair is within :data:`STALL_DISTANCE` at q_a."""
+    """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and at
+    q_b (unless ``grid`` has END_KNOWN), first one-sided reach; False when a pair is within
+    :data:`STALL_DISTANCE` at q_a.
+
+    A pair is certified on the whole edge at once by the static motion bound L (its motion
+    over any interval of length ds is at most L ds): one-sided when its slack at q_a is at
+    least L, two-sided when the slacks at both ends sum to more than L, or on both halves when
+    the midpoint's bounds are known (MIDPOINT) and each half's end slacks sum to more than
+    L / 2 (the test of :func:`span_motion` with the static bound). A pair certified on the
+    first half only starts at the midpoint.
+    """
     pairs, rates = model[8], model[9]
     count = pairs.shape[0]
     dq, counters, slack = scratch[14], scratch[9], scratch[4]
+    end, middle = scratch[19], scratch[18]
     reach, where, all_arms, trend = scratch[5], scratch[6], scratch[15], scratch[16]
     for j in range(q_a.shape[0]):
         dq[j] = abs(q_b[j] - q_a[j])
     counters[0] += 1
     counters[1] += 1
     counters[2] += count
+    if grid & END_KNOWN == 0:
+        primitive_poses(q_b, model, scratch)
+        all_pair_bounds(model, scratch[3], end)
+        for p in range(count):
+            end[p] -= clearance
     primitive_poses(q_a, model, scratch)
+    if not known:
+        all_pair_bounds(model, scratch[3], slack)
+        for p in range(count):
+            slack[p] -= clearance
     for p in range(count):
         static = 0.0
         for j in range(dq.shape[0]):
             static += rates[p, j] * dq[j]
-        if not known:  # the sphere gap alone when it proves the pair for the whole edge
-            enough = clearance + max(static, STALL_DISTANCE) + 1e-12
-            slack[p] = pair_bound_below(p, model, scratch, enough) - clearance
         if slack[p] <= STALL_DISTANCE:
             counters[3] = p
             return False
         where[p] = 0.0
         trend[p] = 0.0
-        if slack[p] >= static:  # certified to s = 1 by the static bound alone
-            reach[p] = np.inf
-            continue
+        reach[p] = np.inf
+        if slack[p] >= static or slack[p] + end[p] > static:
+            continue  # certified to s = 1 by the static bound alone
+        if grid & MIDPOINT != 0:
+            mid = middle[p] - clearance
+            if mid > STALL_DISTANCE and slack[p] + mid > 0.5 * static:
+                if mid + end[p] > 0.5 * static:
+                    continue  # both halves certified
+                where[p], slack[p] = 0.5, mid
+                all_arms[p, :] = rates[p]  # lever arms at most the static reach
+                reach[p] = 0.5 + reach_step(mid, p, all_arms[p], model, scratch)
+                continue
         lever_arms(p, scratch[0], scratch[3], model, all_arms[p])
         reach[p] = reach_step(slack[p], p, all_arms[p], model, scratch)
     return True
 
 
+@numba.njit(cache=True, inline="always")
+def _place_lanes(s: float, sigma: float, one: float, trend: float, out: np.ndarray) -> bool:
+    """The points of a run (:func:`_lane_run`) from s, slack sigma [m], one-sided step ``one``
+    and slack trend [m per unit s] -> out[OUT_S]; False when there is no step to take."""
+    if one <= 0.0 or sigma <= 0.0:
+        return False
+    speed = sigma / one
+    rate = min(max(trend, -speed), speed)
+    closing = speed - rate
+    u, predicted = s, sigma
+    for i in range(LANES):
+        step = MAX_GROWTH * predicted / speed
+        if closing > 0.0:
+            step = min(step, LANE_GROWTH * predicted / closing)
+        u = min(1.0, u + step)
+        predicted = max(predicted + rate * step, LANE_FLOOR * sigma)
+        out[OUT_S, i] = u
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _farthest(
+    i: int,
+    s: float,
+    sigma: float,
+    own: float,
+    p: int,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> int:
+    """The farthest lane k >= i of a run (scratch[17]) certified from s (slack sigma [m], lever
+    arms scratch[13][0], one-sided reach s + own) with slack above STALL_DISTANCE, scanning
+    forward until a lane fails after one passed; -1: none; -2 - k: lane k, the first lane
+    after s, is a wall (slack within STALL_DISTANCE)."""
+    out, arms = scratch[17], scratch[13]
+    best = -1
+    for k in range(i, LANES):
+        t = out[OUT_S, k]
+        sigma_t = out[OUT_BOUND, k] - clearance
+        if t <= s:
+            continue
+        if sigma_t <= STALL_DISTANCE:
+            return -2 - k if best < 0 else best
+        ok = t <= s + own
+        if not ok:
+            for j in range(arms.shape[1]):
+                arms[1, j] = out[OUT_ARMS + j, k]
+            ok = sigma + sigma_t > span_motion(p, t - s, model, scratch)
+        if ok:
+            best = k
+        elif best >= 0:
+            break
+    return best
+
+
+@numba.njit(cache=True)
+def _lane_run(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    p: int,
+    nearest: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> float:
+    """Advance pair p through up to LANES points at once: its bounds and lever arms there come
+    from one vectorised call (:func:`lynxplan.planning.lanes.pair_along`).
+
+    The points follow the pair's slack trend: steps of :data:`LANE_GROWTH` times the predicted
+    slack over the closing speed (the slack falling or rising linearly at its last rate), so
+    they crowd where the pair approaches something. From the last accepted point, the farthest
+    of the next points is accepted whose interval from it is certified — by the two-sided test
+    (:func:`span_motion`) or because the point lies within the one-sided reach
+    (:func:`reach_step`) — and whose slack exceeds :data:`STALL_DISTANCE`; a point with less
+    slack is a wall the run does not pass. Updates the pair's state (where, slack, arms, trend,
+    reach) as single steps would.
+
+    Returns 1 when a point was accepted; -t when the first point t lies within the pair's
+    one-sided reach ``nearest`` (certified to t) and its slack is within STALL_DISTANCE (the
+    walk stops there, as a single step would); 0 otherwise (the caller takes a single step)."""
+    slack, reach, where, arms = scratch[4], scratch[5], scratch[6], scratch[13]
+    all_arms, trend, out, counters = scratch[15], scratch[16], scratch[17], scratch[9]
+    s, sigma = where[p], slack[p]
+    if not _place_lanes(s, sigma, nearest - s, trend[p], out):
+        return 0.0
+    pair_along(q_a, q_b, p, model, out)
+    counters[1] += LANES
+    counters[2] += LANES
+    nq = q_a.shape[0]
+    accepted, i = 0, 0
+    own = reach_step(sigma, p, arms[0], model, scratch)
+    while i < LANES:
+        best = _farthest(i, s, sigma, own, p, model, scratch, clearance)
+        if best < -1:  # a wall at the first point
+            t = float(out[OUT_S, -2 - best])
+            if accepted == 0 and t <= nearest:
+                return -t
+            break
+        if best < 0:
+            break
+        t = out[OUT_S, best]
+        sigma_t = out[OUT_BOUND, best] - clearance
+        trend[p] = (sigma_t - sigma) / (t - s)
+        s, sigma = t, sigma_t
+        for j in range(nq):
+            arms[0, j] = out[OUT_ARMS + j, best]
+        own = reach_step(sigma, p, arms[0], model, scratch)
+        accepted += 1
+        i = best + 1
+        if s >= 1.0:
+            break
+    if accepted == 0:
+        return 0.0
+    where[p], slack[p] = s, sigma
+    all_arms[p, :] = arms[0]
+    reach[p] = s + own
+    return 1.0
+
+
 @numba.njit(cache=True)
 def edge_walk(
-    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float, known: bool
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    known: bool,
+    grid: int,
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
-    ``known``, scratch[4] holds the pairs' slacks at q_a.
+    ``known``, scratch[4] holds the pairs' slacks at q_a; ``grid``: what else is known
+    (:data:`END_KNOWN`, :data:`MIDPOINT`; :func:`_walk_start` certifies most pairs with them).
 
     Every pair keeps the last point s_p of the edge where its bound was evaluated, its slack
     sigma_p above the clearance there, and the point it is certified to. The pair certified
@@ -247,8 +433,9 @@ def edge_walk(
     counters, slack = scratch[9], scratch[4]
     reach, where, arms, all_arms = scratch[5], scratch[6], scratch[13], scratch[15]
     trend = scratch[16]
-    if not _walk_start(q_a, q_b, model, scratch, clearance, known):
+    if not _walk_start(q_a, q_b, model, scratch, clearance, known, grid):
         return -1.0
+    lanes = model[0].shape[0] <= MAX_JOINTS and q_a.shape[0] <= MAX_JOINTS
     while True:
         p, nearest = 0, np.inf
         for k in range(count):
@@ -265,7 +452,14 @@ def edge_walk(
         closing = speed - min(max(trend[p], -speed), speed)
         span = STEP_GROWTH * slack[p] / closing if closing > 0.0 else MAX_GROWTH * one
         arms[0, :] = all_arms[p]
-        if span > 1.2 * one:
+        if lanes:
+            run = _lane_run(q_a, q_b, p, nearest, model, scratch, clearance)
+            if run > 0.0:
+                continue
+            if run < 0.0:  # blocked within the one-sided reach: the edge is certified to -run
+                counters[3] = p
+                return -run
+        if not lanes and span > 1.2 * one:  # (the lanes' first point was this one)
             t = min(1.0, s + min(span, MAX_GROWTH * one))
             slack_t = _pair_at(q_a, q_b, t, p, model, scratch, 1) - clearance
             if slack_t > STALL_DISTANCE and slack[p] + slack_t > span_motion(
@@ -291,4 +485,4 @@ def edge_is_free(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
     """Whether the whole edge from q_a to q_b is certified (:func:`edge_fraction`)."""
-    return edge_fraction(q_a, q_b, model, scratch, clearance) >= 1.0
+    return edge_walk(q_a, q_b, model, scratch, clearance, False, 0) >= 1.0

@@ -15,6 +15,9 @@ import numpy as np
 from lynxplan.collision.obstacles import BoxObstacle, CylinderObstacle, SphereObstacle
 from lynxplan.collision.world import CollisionWorld
 
+#: Configurations per call of the vectorised kernel :func:`lynxplan.planning.lanes.pair_along`
+#: (one AVX-512 register of doubles).
+LANES = 8
 #: Obstacle kinds of the kernels.
 OBSTACLE_BOX, OBSTACLE_SPHERE = 0, 1
 
@@ -64,7 +67,10 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
     """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
     counters (edge checks, advancement steps, pair bounds evaluated) and the pair that last
     failed a quick state test, the joint and primitive poses at an edge's start, the joints'
-    lever arms at two points of an edge and the joint steps of an edge."""
+    lever arms at two points of an edge, the joint steps of an edge, every pair's lever arms
+    and slack trend on an edge, the output rows of :func:`lynxplan.planning.lanes.pair_along`
+    and every pair's bound at one configuration (the midpoint of the last quick edge test) and
+    slack at an edge's end."""
     joints, prims, pairs, nq = len(model[0]), len(model[4]), len(model[8]), model[9].shape[1]
     del prims
     return (
@@ -84,6 +90,9 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         np.empty((2, nq)),
         np.empty(nq),
         np.empty((pairs, nq)),
+        np.empty(pairs),
+        np.empty((2 + nq, LANES)),
+        np.empty(pairs),
         np.empty(pairs),
     )
 

@@ -35,8 +35,12 @@ import numpy as np
 
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.edge_walk import edge_fraction_from, edge_is_free, state_slacks
-from lynxplan.planning.validity import ValidityChecker, pair_bound, point_is_clear, primitive_poses
+from lynxplan.planning.edge_walk import (
+    edge_fraction_from,
+    edge_is_free_after_midpoint,
+    state_slacks,
+)
+from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
 
 #: Kernel status codes.
 RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2
@@ -145,9 +149,9 @@ def _slacks(
     is valid once the flag is set; a node's slacks never change)."""
     if known[tree, index] == 0:
         out = slacks[tree, index]
-        primitive_poses(nodes[tree, index], model, scratch)
+        state_bounds(nodes[tree, index], model, scratch, out)
         for p in range(out.shape[0]):
-            out[p] = pair_bound(p, model, scratch) - clearance
+            out[p] -= clearance
         known[tree, index] = 1
     result: np.ndarray = slacks[tree, index]
     return result
@@ -161,16 +165,21 @@ def _extends(
     tree: int,
     near: int,
     new: np.ndarray,
+    fresh: np.ndarray,
     model: Any,
     scratch: Any,
     clearance: float,
 ) -> bool:
-    """Whether the edge from node ``near`` of ``tree`` to ``new`` (nq,) is certified whole (a
-    blocked extension is usually blocked at its midpoint: that quick test first)."""
+    """Whether the edge from node ``near`` of ``tree`` to ``new`` (nq,; its slacks: fresh
+    (P,)) is certified whole (a blocked extension is usually blocked at its midpoint: that
+    quick test first; its bounds then serve the walk)."""
     if not point_is_clear(nodes[tree, near], new, 0.5, model, scratch, clearance):
         return False
     start = _slacks(nodes, slacks, known, tree, near, model, scratch, clearance)
-    return bool(edge_fraction_from(nodes[tree, near], new, start, model, scratch, clearance) >= 1.0)
+    reached = edge_fraction_from(
+        nodes[tree, near], new, start, fresh, True, model, scratch, clearance
+    )
+    return bool(reached >= 1.0)
 
 
 @numba.njit(cache=True)
@@ -225,7 +234,7 @@ def rrt_connect_kernel(
         if not state_slacks(new, model, scratch, clearance, fresh):
             meta[0] = b
             continue
-        if not _extends(nodes, slacks, known, a, near, new, model, scratch, clearance):
+        if not _extends(nodes, slacks, known, a, near, new, fresh, model, scratch, clearance):
             meta[0] = b
             continue
         added = _add(nodes, parents, counts, a, new, near)
@@ -239,7 +248,7 @@ def rrt_connect_kernel(
             length += (new[j] - base[j]) ** 2
         length = math.sqrt(length)
         start = _slacks(nodes, slacks, known, b, other, model, scratch, clearance)
-        reached = edge_fraction_from(base, new, start, model, scratch, clearance)
+        reached = edge_fraction_from(base, new, start, fresh, False, model, scratch, clearance)
         parent = other
         pieces = max(1, math.ceil(length / step))
         for k in range(1, pieces + 1):
@@ -266,9 +275,9 @@ def straight_goal(
     """The first goal (K, nq) whose straight edge from start (nq,) is certified, or -1 (a
     blocked edge is usually blocked at its midpoint: that quick test first)."""
     for k in range(goals.shape[0]):
-        if point_is_clear(start, goals[k], 0.5, model, scratch, clearance) and edge_is_free(
-            start, goals[k], model, scratch, clearance
-        ):
+        if point_is_clear(
+            start, goals[k], 0.5, model, scratch, clearance
+        ) and edge_is_free_after_midpoint(start, goals[k], model, scratch, clearance):
             return k
     return -1
 

@@ -37,7 +37,7 @@ import numba
 import numpy as np
 
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.edge_walk import edge_is_free
+from lynxplan.planning.edge_walk import edge_is_free, edge_is_free_after_midpoint
 from lynxplan.planning.validity import ValidityChecker, point_is_clear
 
 #: Shortcut attempts by default.
@@ -89,9 +89,9 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
     while i < count - 1:
         j = count - 1
         while j > i + 1:
-            if point_is_clear(path[i], path[j], 0.5, model, scratch, clearance) and edge_is_free(
-                path[i], path[j], model, scratch, clearance
-            ):
+            if point_is_clear(
+                path[i], path[j], 0.5, model, scratch, clearance
+            ) and edge_is_free_after_midpoint(path[i], path[j], model, scratch, clearance):
                 break
             j -= 1
         kept += 1
@@ -168,7 +168,7 @@ def _full(
     if i1 == i2 or count + 2 > path.shape[0]:
         return 0
     if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
-        not edge_is_free(first, second, model, scratch, clearance)
+        not edge_is_free_after_midpoint(first, second, model, scratch, clearance)
     ):
         return 0
     return _splice(path, count, i1, i2, piece, 2, work)  # path[..i1], first, second, path[i2+1..]
@@ -407,7 +407,7 @@ def shortcut_kernel(
     while k < count - 1:
         if point_is_clear(
             path[k - 1], path[k + 1], 0.5, model, scratch, clearance
-        ) and edge_is_free(path[k - 1], path[k + 1], model, scratch, clearance):
+        ) and edge_is_free_after_midpoint(path[k - 1], path[k + 1], model, scratch, clearance):
             for m in range(k, count - 1):
                 path[m] = path[m + 1]
             count -= 1

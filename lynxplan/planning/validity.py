@@ -43,6 +43,7 @@ from lynxplan.planning.kernel_model import (
     make_scratch,
     planner_pairs,
 )
+from lynxplan.planning.lanes import all_pair_bounds
 
 #: An edge walk stops when a pair's bound is within this of the required clearance, in [m]:
 #: every step then advances by at least this over the pair's motion rate (no endless creeping).
@@ -262,20 +263,39 @@ def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
 
 @numba.njit(cache=True)
 def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> None:
-    """Lower bound of the distance of every pair at q (nq,) -> out (P,), in [m]."""
+    """Lower bound of the distance of every pair at q (nq,) -> out (P,), in [m] (all pairs at
+    once: :func:`lynxplan.planning.lanes.all_pair_bounds`)."""
     primitive_poses(q, model, scratch)
-    for p in range(model[8].shape[0]):
-        out[p] = pair_bound(p, model, scratch)
+    all_pair_bounds(model, scratch[3], out)
 
 
 @numba.njit(cache=True)
 def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
     """Smallest pair bound at q (nq,), in [m] (inf without pairs)."""
-    primitive_poses(q, model, scratch)
+    bounds = scratch[18]
+    state_bounds(q, model, scratch, bounds)
     best = np.inf
-    for p in range(model[8].shape[0]):
-        best = min(best, pair_bound(p, model, scratch))
+    for p in range(bounds.shape[0]):
+        best = min(best, bounds[p])
     return best
+
+
+@numba.njit(cache=True)
+def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: np.ndarray) -> int:
+    """Every pair's bound at q (nq,) -> out (P,), in [m], and the first pair whose bound is at
+    most ``threshold`` [m] (-1: none). The pair that failed last (scratch[9][3]) is tried
+    alone first (a blocked region usually blocks the same pair): when it fails, -2 - that pair
+    is returned and out is not filled."""
+    primitive_poses(q, model, scratch)
+    count, last = model[8].shape[0], scratch[9][3]
+    if last < count and pair_bound_below(last, model, scratch, threshold) <= threshold:
+        return int(-2 - last)
+    all_pair_bounds(model, scratch[3], out)
+    for p in range(count):
+        if out[p] <= threshold:
+            scratch[9][3] = p
+            return p
+    return -1
 
 
 @numba.njit(cache=True)
@@ -290,13 +310,4 @@ def point_is_clear(
     q = scratch[7]
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-    primitive_poses(q, model, scratch)
-    count, last = model[8].shape[0], scratch[9][3]
-    threshold = clearance + STALL_DISTANCE
-    if last < count and pair_bound_below(last, model, scratch, threshold) <= threshold:
-        return False
-    for p in range(count):
-        if p != last and pair_bound_below(p, model, scratch, threshold) <= threshold:
-            scratch[9][3] = p
-            return False
-    return True
+    return first_below(q, model, scratch, clearance + STALL_DISTANCE, scratch[18]) == -1

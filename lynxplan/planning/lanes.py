@@ -1,0 +1,403 @@
+"""One pair's distance bound at several points of an edge at once: a vectorised numba kernel.
+
+:func:`pair_along` computes, for one checked pair and :data:`LANES` parameters ``s_i`` of the
+straight joint edge ``q(s) = q_a + s (q_b - q_a)``, the same quantities as one step of the
+scalar edge walk (:func:`lynxplan.planning.edge_walk.pose_pair_at` and
+:func:`lynxplan.planning.validity.pair_bound`): the pair's lower bound of the distance and its
+lever arms about each joint. The lanes are the innermost loop of every computation, stored as
+rows of a constant-width scratch array (structure of arrays, one row a quantity), with selects
+instead of branches, so LLVM turns each loop into SIMD instructions (several configurations
+for about the price of one).
+
+The bound is the same kind as the scalar one, computed over every axis: the larger of the
+bounding-sphere gap and the separating-axis gap over all 15 axes of the separating axis theorem
+(the scalar kernel may skip the 9 edge axes, which only lowers its bound); a sphere obstacle is
+bounded exactly by the point-box distance minus its radius. Each is a lower bound of the
+Euclidean distance (:mod:`lynxplan.planning.validity`). An edge axis whose squared norm
+``1 - (a_i . b_j)^2`` is below :data:`_PARALLEL` (near-parallel edges) is left out: any subset
+of the axes gives a valid bound, and its normalisation would amplify rounding.
+
+The walk (:func:`lynxplan.planning.edge_walk.edge_walk`) uses the lanes as a speculative run of
+two-sided steps of one pair: every interval between consecutive lanes is certified by the same
+test as a scalar two-sided step, the first that fails ends the run.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba
+import numpy as np
+
+from lynxplan._fastmath import sincos
+from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE
+
+#: Joints (frames) a kernel model may have for the lanes (the scalar walk serves larger ones).
+MAX_JOINTS = 12
+#: Edge axes with squared norm below this are left out (near-parallel edges).
+_PARALLEL = 1e-6
+#: IEEE-safe fast-math flags (fused multiply-add, reciprocal division; see ik_kernel).
+_FAST = {"contract", "arcp"}
+
+# Scratch rows: 12 per joint frame (rotation row-major, then translation); then constant rows
+# that every vectorised loop reads and writes (a loop between rows at run-time offsets would
+# need aliasing checks, and LLVM gives up on many): the input pose P, the new pose N, the two
+# primitives of the pair A and B, the parameters S, a result T and the bound.
+_P = 12 * MAX_JOINTS
+_N = _P + 12
+_A = _N + 12
+_B = _A + 12
+_S = _B + 12
+_T = _S + 1
+_BOUND = _T + 1
+_ROWS = _BOUND + 1
+#: Rows of the output of :func:`pair_along`: 0 the bound [m], 1 the parameter s (input), 2 + j
+#: the lever arm about configuration index j [m].
+OUT_BOUND, OUT_S, OUT_ARMS = 0, 1, 2
+
+
+def lanes_supported(model: tuple[np.ndarray, ...]) -> bool:
+    """Whether :func:`pair_along` serves a kernel model (few enough joints and coordinates)."""
+    return len(model[0]) <= MAX_JOINTS and model[9].shape[1] <= MAX_JOINTS
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _copy_rows(w: np.ndarray, dst: int, src: int, count: int) -> None:
+    """Rows src..src+count-1 of w -> rows dst..dst+count-1."""
+    for r in range(count):
+        for i in range(LANES):
+            w[dst + r, i] = w[src + r, i]
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _joint_rows(w: np.ndarray, j: int, model: Any, q_a: np.ndarray, q_b: np.ndarray) -> None:
+    """World pose of joint frame j in every lane (its parent's rows ready): the parent's pose,
+    the joint placement, then the rotation about the joint axis (it turns two columns)."""
+    axes, index_q, parents, pl = model[0], model[1], model[2], model[3]
+    a = axes[j]
+    i1, i2 = (a + 1) % 3, (a + 2) % 3
+    qa, dq = q_a[index_q[j]], q_b[index_q[j]] - q_a[index_q[j]]
+    p00, p01, p02, p03 = pl[j, 0, 0], pl[j, 0, 1], pl[j, 0, 2], pl[j, 0, 3]
+    p10, p11, p12, p13 = pl[j, 1, 0], pl[j, 1, 1], pl[j, 1, 2], pl[j, 1, 3]
+    p20, p21, p22, p23 = pl[j, 2, 0], pl[j, 2, 1], pl[j, 2, 2], pl[j, 2, 3]
+    # column k of the new rotation: M_k (k = a), c M_i1 + s M_i2 (k = i1), c M_i2 - s M_i1
+    _copy_rows(w, _P, 12 * parents[j], 12)
+    for i in range(LANES):
+        s, c = sincos(qa + w[_S, i] * dq)
+        for r in range(3):
+            u0, u1, u2 = w[_P + 3 * r, i], w[_P + 3 * r + 1, i], w[_P + 3 * r + 2, i]
+            m0 = u0 * p00 + u1 * p10 + u2 * p20
+            m1 = u0 * p01 + u1 * p11 + u2 * p21
+            m2 = u0 * p02 + u1 * p12 + u2 * p22
+            w[_N + 9 + r, i] = u0 * p03 + u1 * p13 + u2 * p23 + w[_P + 9 + r, i]
+            mi1 = m1 if i1 == 1 else (m2 if i1 == 2 else m0)
+            mi2 = m1 if i2 == 1 else (m2 if i2 == 2 else m0)
+            first = c * mi1 + s * mi2
+            second = c * mi2 - s * mi1
+            w[_N + 3 * r, i] = m0 if a == 0 else (first if i1 == 0 else second)
+            w[_N + 3 * r + 1, i] = m1 if a == 1 else (first if i1 == 1 else second)
+            w[_N + 3 * r + 2, i] = m2 if a == 2 else (first if i1 == 2 else second)
+    _copy_rows(w, 12 * j, _N, 12)
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _primitive_rows(w: np.ndarray, out: int, g: int, model: Any) -> None:
+    """World pose of primitive g in every lane -> rows out..out+11."""
+    pl = model[5]
+    p00, p01, p02, p03 = pl[g, 0, 0], pl[g, 0, 1], pl[g, 0, 2], pl[g, 0, 3]
+    p10, p11, p12, p13 = pl[g, 1, 0], pl[g, 1, 1], pl[g, 1, 2], pl[g, 1, 3]
+    p20, p21, p22, p23 = pl[g, 2, 0], pl[g, 2, 1], pl[g, 2, 2], pl[g, 2, 3]
+    _copy_rows(w, _P, 12 * model[4][g], 12)
+    for i in range(LANES):
+        for r in range(3):
+            u0, u1, u2 = w[_P + 3 * r, i], w[_P + 3 * r + 1, i], w[_P + 3 * r + 2, i]
+            w[out + 3 * r, i] = u0 * p00 + u1 * p10 + u2 * p20
+            w[out + 3 * r + 1, i] = u0 * p01 + u1 * p11 + u2 * p21
+            w[out + 3 * r + 2, i] = u0 * p02 + u1 * p12 + u2 * p22
+            w[out + 9 + r, i] = u0 * p03 + u1 * p13 + u2 * p23 + w[_P + 9 + r, i]
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _fixed_rows(w: np.ndarray, out: int, poses: np.ndarray, b: int) -> None:
+    """The fixed pose poses[b] (4, 4) in every lane -> rows out..out+11."""
+    for r in range(3):
+        for c in range(3):
+            value = poses[b, r, c]
+            for i in range(LANES):
+                w[out + 3 * r + c, i] = value
+        value = poses[b, r, 3]
+        for i in range(LANES):
+            w[out + 9 + r, i] = value
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _box_bounds(
+    w: np.ndarray, half_a: np.ndarray, a: int, half_b: np.ndarray, b: int, rab: float
+) -> None:
+    """Lower bound of the distance of box A (rows _A, half sizes half_a[a]) and box B (rows
+    _B, half sizes half_b[b]), every lane -> row _BOUND (:func:`obb_gap`; rab: the two
+    bounding radii)."""
+    ha0, ha1, ha2 = half_a[a, 0], half_a[a, 1], half_a[a, 2]
+    hb0, hb1, hb2 = half_b[b, 0], half_b[b, 1], half_b[b, 2]
+    for i in range(LANES):
+        w[_BOUND, i] = obb_gap(
+            w[_B + 9, i] - w[_A + 9, i],
+            w[_B + 10, i] - w[_A + 10, i],
+            w[_B + 11, i] - w[_A + 11, i],
+            (w[_A, i], w[_A + 1, i], w[_A + 2, i]),
+            (w[_A + 3, i], w[_A + 4, i], w[_A + 5, i]),
+            (w[_A + 6, i], w[_A + 7, i], w[_A + 8, i]),
+            (w[_B, i], w[_B + 1, i], w[_B + 2, i]),
+            (w[_B + 3, i], w[_B + 4, i], w[_B + 5, i]),
+            (w[_B + 6, i], w[_B + 7, i], w[_B + 8, i]),
+            (ha0, ha1, ha2),
+            (hb0, hb1, hb2),
+            rab,
+        )
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def obb_gap(
+    t0: float,
+    t1: float,
+    t2: float,
+    ra0: tuple[float, float, float],
+    ra1: tuple[float, float, float],
+    ra2: tuple[float, float, float],
+    rb0: tuple[float, float, float],
+    rb1: tuple[float, float, float],
+    rb2: tuple[float, float, float],
+    ha: tuple[float, float, float],
+    hb: tuple[float, float, float],
+    rab: float,
+) -> float:
+    """Lower bound of the distance of two oriented boxes, in [m]: the larger of the sphere gap
+    ``|t| - rab`` and the separating-axis gap over the 15 axes.
+
+    t: centre of B minus centre of A (world); ra0..ra2, rb0..rb2: rows of the boxes' rotations
+    (columns: the box axes); ha, hb: half sizes; rab: the sum of their bounding radii. No
+    branch: a select leaves out near-parallel edge axes.
+    """
+    a00, a01, a02 = ra0
+    a10, a11, a12 = ra1
+    a20, a21, a22 = ra2
+    b00, b01, b02 = rb0
+    b10, b11, b12 = rb1
+    b20, b21, b22 = rb2
+    ha0, ha1, ha2 = ha
+    hb0, hb1, hb2 = hb
+    # m_kl = a_k . b_l
+    m00 = a00 * b00 + a10 * b10 + a20 * b20
+    m01 = a00 * b01 + a10 * b11 + a20 * b21
+    m02 = a00 * b02 + a10 * b12 + a20 * b22
+    m10 = a01 * b00 + a11 * b10 + a21 * b20
+    m11 = a01 * b01 + a11 * b11 + a21 * b21
+    m12 = a01 * b02 + a11 * b12 + a21 * b22
+    m20 = a02 * b00 + a12 * b10 + a22 * b20
+    m21 = a02 * b01 + a12 * b11 + a22 * b21
+    m22 = a02 * b02 + a12 * b12 + a22 * b22
+    r00, r01, r02 = abs(m00), abs(m01), abs(m02)
+    r10, r11, r12 = abs(m10), abs(m11), abs(m12)
+    r20, r21, r22 = abs(m20), abs(m21), abs(m22)
+    # t in A's frame and in B's frame
+    u0 = a00 * t0 + a10 * t1 + a20 * t2
+    u1 = a01 * t0 + a11 * t1 + a21 * t2
+    u2 = a02 * t0 + a12 * t1 + a22 * t2
+    v0 = b00 * t0 + b10 * t1 + b20 * t2
+    v1 = b01 * t0 + b11 * t1 + b21 * t2
+    v2 = b02 * t0 + b12 * t1 + b22 * t2
+    best = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2) - rab
+    best = max(best, abs(u0) - ha0 - hb0 * r00 - hb1 * r01 - hb2 * r02)
+    best = max(best, abs(u1) - ha1 - hb0 * r10 - hb1 * r11 - hb2 * r12)
+    best = max(best, abs(u2) - ha2 - hb0 * r20 - hb1 * r21 - hb2 * r22)
+    best = max(best, abs(v0) - hb0 - ha0 * r00 - ha1 * r10 - ha2 * r20)
+    best = max(best, abs(v1) - hb1 - ha0 * r01 - ha1 * r11 - ha2 * r21)
+    best = max(best, abs(v2) - hb2 - ha0 * r02 - ha1 * r12 - ha2 * r22)
+    # edge axes a_k x b_l, in A's frame e_k x (m_0l, m_1l, m_2l); squared norm 1 - m_kl^2
+    best = _edge(best, u2 * m10 - u1 * m20, ha1 * r20 + ha2 * r10, hb1 * r02 + hb2 * r01, m00)
+    best = _edge(best, u2 * m11 - u1 * m21, ha1 * r21 + ha2 * r11, hb0 * r02 + hb2 * r00, m01)
+    best = _edge(best, u2 * m12 - u1 * m22, ha1 * r22 + ha2 * r12, hb0 * r01 + hb1 * r00, m02)
+    best = _edge(best, u0 * m20 - u2 * m00, ha0 * r20 + ha2 * r00, hb1 * r12 + hb2 * r11, m10)
+    best = _edge(best, u0 * m21 - u2 * m01, ha0 * r21 + ha2 * r01, hb0 * r12 + hb2 * r10, m11)
+    best = _edge(best, u0 * m22 - u2 * m02, ha0 * r22 + ha2 * r02, hb0 * r11 + hb1 * r10, m12)
+    best = _edge(best, u1 * m00 - u0 * m10, ha0 * r10 + ha1 * r00, hb1 * r22 + hb2 * r21, m20)
+    best = _edge(best, u1 * m01 - u0 * m11, ha0 * r11 + ha1 * r01, hb0 * r22 + hb2 * r20, m21)
+    best = _edge(best, u1 * m02 - u0 * m12, ha0 * r12 + ha1 * r02, hb0 * r21 + hb1 * r20, m22)
+    return best
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _edge(best: float, along: float, radius_a: float, radius_b: float, m: float) -> float:
+    """best, or the gap along edge axis L (projection of t on L: along; the boxes' radii on L:
+    radius_a, radius_b; m the cosine of the two edges, |L|^2 = 1 - m^2) if larger."""
+    norm2 = 1.0 - m * m
+    gap = (abs(along) - radius_a - radius_b) / math.sqrt(max(norm2, _PARALLEL))
+    return max(best, gap) if norm2 > _PARALLEL else best
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _sphere_bounds(w: np.ndarray, half: np.ndarray, a: int, model: Any, b: int) -> None:
+    """Distance of box A (rows _A, half sizes half[a]) to sphere obstacle b, every lane -> row
+    _BOUND (exact: point-box distance minus the radius)."""
+    c0, c1, c2 = model[11][b, 0], model[11][b, 1], model[11][b, 2]
+    radius = model[13][b, 0]
+    ha = (half[a, 0], half[a, 1], half[a, 2])
+    for i in range(LANES):
+        d0, d1, d2 = c0 - w[_A + 9, i], c1 - w[_A + 10, i], c2 - w[_A + 11, i]
+        e0 = max(abs(w[_A, i] * d0 + w[_A + 3, i] * d1 + w[_A + 6, i] * d2) - ha[0], 0.0)
+        e1 = max(abs(w[_A + 1, i] * d0 + w[_A + 4, i] * d1 + w[_A + 7, i] * d2) - ha[1], 0.0)
+        e2 = max(abs(w[_A + 2, i] * d0 + w[_A + 5, i] * d1 + w[_A + 8, i] * d2) - ha[2], 0.0)
+        w[_BOUND, i] = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) - radius
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _arm_row(w: np.ndarray, rows: int, extra: float) -> None:
+    """Lever arm about the axis in rows _P (direction) and _P + 3 (a point on it) of the
+    primitive in rows ``rows`` (its centre), plus ``extra`` [m], every lane -> row _T."""
+    for i in range(LANES):
+        w0, w1, w2 = w[_P, i], w[_P + 1, i], w[_P + 2, i]
+        d0 = w[rows + 9, i] - w[_P + 3, i]
+        d1 = w[rows + 10, i] - w[_P + 4, i]
+        d2 = w[rows + 11, i] - w[_P + 5, i]
+        c0, c1, c2 = w1 * d2 - w2 * d1, w2 * d0 - w0 * d2, w0 * d1 - w1 * d0
+        w[_T, i] = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) + extra
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _arm_rows(w: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
+    """Lever arms of pair p about each configuration index, every lane -> out[OUT_ARMS + j]
+    (as :func:`lynxplan.planning.edge_walk.lever_arms`)."""
+    axes, radius, owners, joints, pairs = model[0], model[7], model[15], model[16], model[8]
+    for j in range(owners.shape[1]):
+        g = owners[p, j]
+        joint = joints[j]
+        if g < 0 or joint < 0:
+            for i in range(LANES):
+                out[OUT_ARMS + j, i] = 0.0
+            continue
+        base, a = 12 * joint, axes[joint]
+        for k in range(3):  # the axis (rotation column a), then the origin
+            _copy_rows(w, _P + k, base + 3 * k + a, 1)
+        _copy_rows(w, _P + 3, base + 9, 3)
+        if g == pairs[p, 0]:
+            _arm_row(w, _A, radius[g])
+        else:
+            _arm_row(w, _B, radius[g])
+        for i in range(LANES):
+            out[OUT_ARMS + j, i] = w[_T, i]
+
+
+@numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
+def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
+    """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
+    [rad]: out[OUT_BOUND] its distance lower bound [m], out[OUT_ARMS + j] its lever arm about
+    configuration index j [m]; out: (2 + nq, LANES).
+
+    The model must satisfy :func:`lanes_supported`.
+    """
+    pairs, prim_joints = model[8], model[4]
+    w = np.empty((_ROWS, LANES))
+    for i in range(LANES):
+        w[_S, i] = out[OUT_S, i]
+    for r in range(12):  # the universe frame: identity
+        value = 1.0 if r % 4 == 0 else 0.0
+        for i in range(LANES):
+            w[r, i] = value
+    a, b, is_self = pairs[p, 0], pairs[p, 1], pairs[p, 2]
+    last = prim_joints[a]
+    if is_self == 1:
+        last = max(last, prim_joints[b])
+    for j in range(1, last + 1):
+        _joint_rows(w, j, model, q_a, q_b)
+    _primitive_rows(w, _A, a, model)
+    half, radius = model[6], model[7]
+    if is_self == 1:
+        _primitive_rows(w, _B, b, model)
+        _box_bounds(w, half, a, half, b, radius[a] + radius[b])
+    elif model[10][b] == OBSTACLE_SPHERE:
+        _sphere_bounds(w, half, a, model, b)
+    else:
+        _fixed_rows(w, _B, model[12], b)
+        _box_bounds(w, half, a, model[13], b, radius[a] + model[14][b])
+    for i in range(LANES):
+        out[OUT_BOUND, i] = w[_BOUND, i]
+    _arm_rows(w, p, model, out)
+
+
+#: Pairs per block of :func:`all_pair_bounds` (a constant width: no run-time aliasing checks).
+PAIR_BLOCK = 64
+# Rows of a block: pose A (12), pose B (12), half sizes A (3), B (3), the two bounding radii,
+# sphere obstacle flag and radius.
+_HA, _HB = 24, 27
+_RAB, _SPHERE, _SR = 30, 31, 32
+_PAIR_ROWS = 33
+
+
+@numba.njit(cache=True, inline="always")
+def _gather_pose(w: np.ndarray, row: int, i: int, poses: np.ndarray, g: int) -> None:
+    for r in range(3):
+        for c in range(3):
+            w[row + 3 * r + c, i] = poses[g, r, c]
+        w[row + 9 + r, i] = poses[g, r, 3]
+
+
+@numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
+def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
+    """Lower bound of every pair's distance at primitive poses (G, 4, 4) -> out (P,), in [m].
+
+    The same bound as :func:`pair_along` (sphere gap, 15 separating axes, exact for a sphere
+    obstacle), for all pairs of one configuration: the pairs' poses are gathered into rows of
+    :data:`PAIR_BLOCK` pairs, then one branch-free loop computes every pair's bound.
+    """
+    pairs, half, radius = model[8], model[6], model[7]
+    kinds, obstacle_poses = model[10], model[12]
+    obstacle_half, obstacle_radius = model[13], model[14]
+    w = np.empty((_PAIR_ROWS, PAIR_BLOCK))
+    count = pairs.shape[0]
+    for start in range(0, count, PAIR_BLOCK):
+        m = min(PAIR_BLOCK, count - start)
+        for i in range(m):
+            p = start + i
+            a, b = pairs[p, 0], pairs[p, 1]
+            _gather_pose(w, 0, i, poses, a)
+            for k in range(3):
+                w[_HA + k, i] = half[a, k]
+            if pairs[p, 2] == 1:
+                _gather_pose(w, 12, i, poses, b)
+                for k in range(3):
+                    w[_HB + k, i] = half[b, k]
+                w[_RAB, i] = radius[a] + radius[b]
+                w[_SPHERE, i] = 0.0
+                w[_SR, i] = 0.0
+            else:
+                _gather_pose(w, 12, i, obstacle_poses, b)
+                for k in range(3):
+                    w[_HB + k, i] = obstacle_half[b, k]
+                w[_RAB, i] = radius[a] + obstacle_radius[b]
+                w[_SPHERE, i] = 1.0 if kinds[b] == OBSTACLE_SPHERE else 0.0
+                w[_SR, i] = obstacle_half[b, 0]
+        for i in range(m):
+            t0, t1, t2 = w[21, i] - w[9, i], w[22, i] - w[10, i], w[23, i] - w[11, i]
+            box = obb_gap(
+                t0,
+                t1,
+                t2,
+                (w[0, i], w[1, i], w[2, i]),
+                (w[3, i], w[4, i], w[5, i]),
+                (w[6, i], w[7, i], w[8, i]),
+                (w[12, i], w[13, i], w[14, i]),
+                (w[15, i], w[16, i], w[17, i]),
+                (w[18, i], w[19, i], w[20, i]),
+                (w[_HA, i], w[_HA + 1, i], w[_HA + 2, i]),
+                (w[_HB, i], w[_HB + 1, i], w[_HB + 2, i]),
+                w[_RAB, i],
+            )
+            # sphere obstacle: the point-box distance of its centre minus its radius (exact)
+            e0 = max(abs(w[0, i] * t0 + w[3, i] * t1 + w[6, i] * t2) - w[_HA, i], 0.0)
+            e1 = max(abs(w[1, i] * t0 + w[4, i] * t1 + w[7, i] * t2) - w[_HA + 1, i], 0.0)
+            e2 = max(abs(w[2, i] * t0 + w[5, i] * t1 + w[8, i] * t2) - w[_HA + 2, i], 0.0)
+            sphere = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) - w[_SR, i]
+            w[_RAB, i] = sphere if w[_SPHERE, i] != 0.0 else box
+        for i in range(m):
+            out[start + i] = w[_RAB, i]
