@@ -37,8 +37,8 @@ import numba
 import numpy as np
 
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.edge_walk import edge_is_free, edge_is_free_after_midpoint
-from lynxplan.planning.validity import ValidityChecker, point_is_clear
+from lynxplan.planning.edge_walk import edge_fraction_from, edge_is_free_after_midpoint
+from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
 
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
@@ -81,21 +81,49 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
 
 
 @numba.njit(cache=True)
+def _slacks_at(
+    points: np.ndarray,
+    k: int,
+    slacks: np.ndarray,
+    known: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> np.ndarray:
+    """Every pair's slack at points[k] (P,), in [m], computed on first use (slacks: (N, P),
+    known: (N,) flags)."""
+    if not known[k]:
+        state_bounds(points[k], model, scratch, slacks[k])
+        for p in range(slacks.shape[1]):
+            slacks[k, p] -= clearance
+        known[k] = True
+    result: np.ndarray = slacks[k]
+    return result
+
+
+@numba.njit(cache=True)
 def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: float) -> int:
     """Vertex shortcuts, farthest first: from each kept waypoint, the farthest later waypoint
-    it sees directly becomes the next one (in place on path[:count]); returns the new count."""
+    it sees directly becomes the next one (in place on path[:count]); returns the new count.
+    Each waypoint's pair slacks are computed once (the edge walks start and end there)."""
+    slacks = np.empty((count, model[8].shape[0]))
+    known = np.zeros(count, dtype=np.bool_)
     kept = 0
     i = 0
     while i < count - 1:
         j = count - 1
         while j > i + 1:
-            if point_is_clear(
-                path[i], path[j], 0.5, model, scratch, clearance
-            ) and edge_is_free_after_midpoint(path[i], path[j], model, scratch, clearance):
-                break
+            if point_is_clear(path[i], path[j], 0.5, model, scratch, clearance):
+                start = _slacks_at(path, i, slacks, known, model, scratch, clearance)
+                end = _slacks_at(path, j, slacks, known, model, scratch, clearance)
+                reached = edge_fraction_from(
+                    path[i], path[j], start, end, True, model, scratch, clearance
+                )
+                if reached >= 1.0:
+                    break
             j -= 1
         kept += 1
-        path[kept] = path[j]
+        path[kept] = path[j]  # kept <= i < j: the rows still to read keep their indices
         i = j
     # path[0..kept] now holds the kept waypoints (later ones were copied down in order).
     return kept + 1
@@ -106,12 +134,24 @@ def _segments_free(
     points: np.ndarray, size: int, model: Any, scratch: Any, clearance: float
 ) -> bool:
     """Whether every straight edge between consecutive rows of points[:size] is certified
-    (quick midpoint tests of all edges first: a blocked edge is usually blocked there)."""
+    (quick midpoint tests of all edges first: a blocked edge is usually blocked there; their
+    bounds then serve the walks, and so do the points' slacks, each computed once)."""
+    pairs = model[8].shape[0]
+    middle = np.empty((max(size - 1, 0), pairs))
     for k in range(size - 1):
         if not point_is_clear(points[k], points[k + 1], 0.5, model, scratch, clearance):
             return False
+        middle[k] = scratch[18]
+    slacks = np.empty((size, pairs))
+    known = np.zeros(size, dtype=np.bool_)
     for k in range(size - 1):
-        if not edge_is_free(points[k], points[k + 1], model, scratch, clearance):
+        start = _slacks_at(points, k, slacks, known, model, scratch, clearance)
+        end = _slacks_at(points, k + 1, slacks, known, model, scratch, clearance)
+        scratch[18][:] = middle[k]
+        reached = edge_fraction_from(
+            points[k], points[k + 1], start, end, True, model, scratch, clearance
+        )
+        if reached < 1.0:
             return False
     return True
 
