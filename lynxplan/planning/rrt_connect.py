@@ -183,6 +183,45 @@ def _extends(
 
 
 @numba.njit(cache=True)
+def _connect(
+    base: np.ndarray,
+    new: np.ndarray,
+    pieces: int,
+    start: np.ndarray,
+    fresh: np.ndarray,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    ahead: np.ndarray,
+) -> float:
+    """How far the straight edge from ``base`` to ``new`` (nq,; their slacks start and fresh
+    (P,)) is certified, as a fraction; only the multiples of 1 / pieces below it matter (the
+    connection adds nodes there).
+
+    The piece points are tested first (quick state tests, in order): the walk then covers the
+    edge only up to the last point that passes, whose bounds it reuses, and is skipped when the
+    first one fails. ahead: (2, P) work rows.
+    """
+    clear = pieces
+    for k in range(1, pieces):
+        if not point_is_clear(base, new, k / pieces, model, scratch, clearance):
+            clear = k - 1
+            break
+        ahead[0] = scratch[18]
+    if clear == 0:
+        return 0.0
+    if clear == pieces:  # two pieces: the one point tested is the midpoint
+        scratch[18][:] = ahead[0]
+        return edge_fraction_from(base, new, start, fresh, pieces == 2, model, scratch, clearance)
+    fraction = clear / pieces
+    target = base + fraction * (new - base)
+    for p in range(ahead.shape[1]):
+        ahead[1, p] = ahead[0, p] - clearance
+    reached = edge_fraction_from(base, target, start, ahead[1], False, model, scratch, clearance)
+    return fraction * reached if reached < 1.0 else fraction
+
+
+@numba.njit(cache=True)
 def rrt_connect_kernel(
     lower: np.ndarray,
     upper: np.ndarray,
@@ -213,6 +252,7 @@ def rrt_connect_kernel(
     sample = np.empty(nq)
     new = np.empty(nq)
     fresh = np.empty(slacks.shape[2])
+    ahead = np.empty((2, slacks.shape[2]))
     for _ in range(iterations):
         a = meta[0]
         b = 1 - a
@@ -248,9 +288,9 @@ def rrt_connect_kernel(
             length += (new[j] - base[j]) ** 2
         length = math.sqrt(length)
         start = _slacks(nodes, slacks, known, b, other, model, scratch, clearance)
-        reached = edge_fraction_from(base, new, start, fresh, False, model, scratch, clearance)
-        parent = other
         pieces = max(1, math.ceil(length / step))
+        reached = _connect(base, new, pieces, start, fresh, model, scratch, clearance, ahead)
+        parent = other
         for k in range(1, pieces + 1):
             s = k / pieces
             if s > reached:
