@@ -1,7 +1,8 @@
 """The vectorised full-pose kernel (``pose_block``) against the scalar one (``pose_kernel``).
 
 Both must give the same slots: the same validity, the same within-limits flags, the same
-"solved" verdict, angles equal to 1e-9 rad and errors no larger on every target: random poses,
+"solved" verdict, angles equal to 1e-9 rad (1e-6 next to a double root) and errors no larger
+on every target: random poses,
 poses next to the yaw axis and next to a fold of the elbow, poses out of reach, approaches along
 the yaw axis, and random family URDFs (exact, and only close to the family). The vector path must
 also carry the load: few poses may fall back to the scalar solver.
@@ -43,7 +44,12 @@ def _assert_same(scalar: tuple, block: tuple) -> None:  # type: ignore[type-arg]
     assert np.array_equal(solved_s, solved_b)
     assert np.array_equal(valid_s, valid_b)
     assert np.array_equal(within_s, within_b)
-    assert np.all(np.abs(q_s - q_b)[valid_s] <= 1e-9)
+    # equal angles; next to a double root (a fold of the elbow) Newton stops at ~1e-11 and the
+    # angles along the fold are only fixed to ~ sqrt(error): there 1e-6 rad
+    loose = np.maximum(perr_s, perr_b) > 1e-13
+    gap = np.abs(q_s - q_b).max(axis=-1)
+    assert np.all(gap[valid_s & ~loose] <= 1e-9)
+    assert np.all(gap[valid_s & loose] <= 1e-6)
     assert np.all(np.isnan(q_b[~valid_b]))
     # no worse than the scalar solver's (whose polish may stop above 1e-12 next to a fold)
     assert np.all(perr_b[valid_b] <= np.maximum(perr_s[valid_b], 1e-14) + 1e-12)

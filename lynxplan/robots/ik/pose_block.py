@@ -16,13 +16,16 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
    angles: the position and orientation errors that are reported.
 
 A candidate is *taken* here only when its final errors are below :data:`VECTOR_EXACT` (far below
-``POSE_EXACT``). Every pose where anything is unusual falls back to the scalar
-``solve_target``, whole: a candidate that did not converge to that (next to a fold of the elbow
-the polish converges linearly), a near fold of a near-family model, both sides of the lateral
+``POSE_EXACT``), and *rejected* (not an exact branch) when its error stopped falling far above
+that. Any other candidate (still converging: next to a fold of the elbow Newton converges
+linearly; or an ill-conditioned polish) is finished by the scalar solver's own polish
+(``pose_kernel.polish_pose``) from its closed-form start, exactly as ``solve_target`` treats it.
+A pose where anything is unusual goes to the scalar ``solve_target``, whole: a near fold of a
+near-family model (where the scalar solver starts the elbows apart), both sides of the lateral
 offset matching the yaw, the approach along the yaw or the pitch axis, the target on the yaw
-axis, or anything not finite. The fixed steps never decide whether a branch exists: a candidate
-that is not taken sends the pose to the scalar solver. Slots, validity and duplicates follow
-the scalar solver's order, so both give the same branches (angles equal to ~1e-15 rad).
+axis, or anything not finite. The fixed steps never decide alone that a branch does not exist
+unless the candidate has stalled. Slots, validity and duplicates follow the scalar solver's
+order, so both give the same branches (angles equal to ~1e-10 rad).
 """
 
 from __future__ import annotations
@@ -38,10 +41,11 @@ from lynxplan import _fastmath
 from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
-from lynxplan.robots.ik.family_polish import is_duplicate
+from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
 from lynxplan.robots.ik.pose_kernel import (
     AXIAL_APPROACH,
     ORIENTATION_ERROR,
+    POSE_EXACT,
     POSITION_ERROR,
     REACH_MISS,
     SLOT_COLUMNS,
@@ -49,6 +53,7 @@ from lynxplan.robots.ik.pose_kernel import (
     WITHIN,
     YAW_MATCH,
     YAW_MATCH_LENGTH,
+    polish_pose,
     solve_target,
 )
 
@@ -79,7 +84,7 @@ FOLD_BAND = 1e-3
 #: The polish's normal matrix this ill-conditioned (smallest over largest LDL^T pivot) falls back.
 ILL_CONDITIONED = 1e-8
 _TWO_PI = 2.0 * math.pi
-_N_CHAIN = 6 * 12 + 5 * 3  # placements (3 x 4 each: M_1..M_5, M_tool) and the five axes
+_N_CHAIN = 6 * 12  # the 3 x 4 blocks of M'_1..M'_5, M'_tool (see ``_chain_tuple``)
 _N_PRM = F.N_PARAMS
 
 # Pose scratch rows: the target (row-major 3 x 4), then per flip: q1, (q2, q3, q4) of elbow up
@@ -90,9 +95,11 @@ _PER_FLIP = 12
 _POSE_FALL = _FLIP0 + 2 * _PER_FLIP
 _ROWS = _POSE_FALL + 1
 # Candidate scratch rows (up to 4 per pose): the target (12), q (5), near a fold, the error
-# before the last chord step, then taken, fallback, within (1/0), position, orientation error.
+# before the last chord step, then taken, fallback, within (1/0), position, orientation error,
+# and the closed-form q (5).
 _C_Q, _C_FOLD, _C_PREV, _C_TAKE, _C_FALL, _C_IN, _C_PERR, _C_OERR = 12, 17, 18, 19, 20, 21, 22, 23
-_C_ROWS = 24
+_C_START = 24  # the closed-form q (5), where a candidate that falls back starts
+_C_ROWS = 29
 _CW = 4 * BLOCK  # the candidate rows' width
 _ALL_TAKEN = np.ones(4, dtype=np.bool_)
 
@@ -264,22 +271,13 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _joint(ch: Floats, j: int, t: Floats, q: float) -> Floats:
-    """The running pose t (12: row-major 3 x 4) times R(u_j, q) M_{j+1}; ch: the chain tuple."""
-    u0, u1, u2 = ch[72 + 3 * j], ch[73 + 3 * j], ch[74 + 3 * j]
+    """The running pose t (12: row-major 3 x 4) times R(z, q) M'_{j+1}; ch: the chain tuple
+    (``_chain_tuple``: every joint turned about its own z axis)."""
     s, c = sincos(q)
-    v = 1.0 - c
-    r00, r01, r02 = c + u0 * u0 * v, u0 * u1 * v - u2 * s, u0 * u2 * v + u1 * s
-    r10, r11, r12 = u1 * u0 * v + u2 * s, c + u1 * u1 * v, u1 * u2 * v - u0 * s
-    r20, r21, r22 = u2 * u0 * v - u1 * s, u2 * u1 * v + u0 * s, c + u2 * u2 * v
-    w00 = t[0] * r00 + t[1] * r10 + t[2] * r20
-    w01 = t[0] * r01 + t[1] * r11 + t[2] * r21
-    w02 = t[0] * r02 + t[1] * r12 + t[2] * r22
-    w10 = t[4] * r00 + t[5] * r10 + t[6] * r20
-    w11 = t[4] * r01 + t[5] * r11 + t[6] * r21
-    w12 = t[4] * r02 + t[5] * r12 + t[6] * r22
-    w20 = t[8] * r00 + t[9] * r10 + t[10] * r20
-    w21 = t[8] * r01 + t[9] * r11 + t[10] * r21
-    w22 = t[8] * r02 + t[9] * r12 + t[10] * r22
+    w00, w01 = c * t[0] + s * t[1], c * t[1] - s * t[0]
+    w10, w11 = c * t[4] + s * t[5], c * t[5] - s * t[4]
+    w20, w21 = c * t[8] + s * t[9], c * t[9] - s * t[8]
+    w02, w12, w22 = t[2], t[6], t[10]
     b = 12 * (j + 1)
     m00, m01, m02, m03 = ch[b], ch[b + 1], ch[b + 2], ch[b + 3]
     m10, m11, m12, m13 = ch[b + 4], ch[b + 5], ch[b + 6], ch[b + 7]
@@ -301,17 +299,10 @@ def _joint(ch: Floats, j: int, t: Floats, q: float) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _axis_of(ch: Floats, j: int, t: Floats) -> Floats:
-    """Joint j's origin and world axis from the running pose t before its rotation."""
-    u0, u1, u2 = ch[72 + 3 * j], ch[73 + 3 * j], ch[74 + 3 * j]
-    return (
-        t[3],
-        t[7],
-        t[11],
-        t[0] * u0 + t[1] * u1 + t[2] * u2,
-        t[4] * u0 + t[5] * u1 + t[6] * u2,
-        t[8] * u0 + t[9] * u1 + t[10] * u2,
-    )
+def _axis_of(t: Floats) -> Floats:
+    """A joint's origin and world axis (its z axis) from the running pose t before its
+    rotation."""
+    return t[3], t[7], t[11], t[2], t[6], t[10]
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -474,15 +465,15 @@ def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q
         ch[10],
         ch[11],
     )
-    o0 = _axis_of(ch, 0, p)
+    o0 = _axis_of(p)
     p = _joint(ch, 0, p, q0)
-    o1 = _axis_of(ch, 1, p)
+    o1 = _axis_of(p)
     p = _joint(ch, 1, p, q1)
-    o2 = _axis_of(ch, 2, p)
+    o2 = _axis_of(p)
     p = _joint(ch, 2, p, q2)
-    o3 = _axis_of(ch, 3, p)
+    o3 = _axis_of(p)
     p = _joint(ch, 3, p, q3)
-    o4 = _axis_of(ch, 4, p)
+    o4 = _axis_of(p)
     p = _joint(ch, 4, p, q4)
     j0, j1, j2 = _column(o0, p), _column(o1, p), _column(o2, p)
     j3, j4 = _column(o3, p), _column(o4, p)
@@ -610,15 +601,31 @@ def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
 
 @numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
-    """The chain's constants as one tuple (see ``_joint``): placements (6, 4, 4), axes (5, 3)."""
+    """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
+    of M'_1 .. M'_5, M'_tool (row-major; placements (6, 4, 4), axes (5, 3)).
+
+    With A_i a rotation taking z to the joint axis u_i, R(u_i, q) = A_i R(z, q) A_i^T, so
+    T(q) = M'_1 R(z, q_1) M'_2 ... R(z, q_5) M'_tool with M'_1 = M_1 A_1, M'_i = A_{i-1}^T M_i A_i
+    and M'_tool = A_5^T M_tool: the same poses, and each joint rotation mixes two columns only.
+    """
+    frames = np.zeros((6, 3, 3))  # A_i (columns x', y', u_i); frames[5]: identity for the tool
+    for k in range(5):
+        u = axes[k]
+        a = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        x = a - (a @ u) * u
+        x /= math.sqrt(x @ x)
+        y = np.cross(u, x)
+        frames[k, :, 0], frames[k, :, 1], frames[k, :, 2] = x, y, u
+    frames[5] = np.eye(3)
     flat = np.empty(_N_CHAIN)
     for k in range(6):
+        before = np.eye(3) if k == 0 else frames[k - 1].T.copy()
+        rotation = before @ np.ascontiguousarray(placements[k, :3, :3]) @ frames[k]
+        translation = before @ np.ascontiguousarray(placements[k, :3, 3])
         for r in range(3):
-            for col in range(4):
-                flat[12 * k + 4 * r + col] = placements[k, r, col]
-    for k in range(5):
-        for col in range(3):
-            flat[72 + 3 * k + col] = axes[k, col]
+            for col in range(3):
+                flat[12 * k + 4 * r + col] = rotation[r, col]
+            flat[12 * k + 4 * r + 3] = translation[r]
     chain: Floats = to_fixed_tuple(flat, _N_CHAIN)  # type: ignore[call-arg]
     return chain
 
@@ -638,7 +645,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     solved: np.ndarray,
 ) -> int:
     """``pose_kernel`` (same arguments and outputs), by blocks of BLOCK vectorised poses with
-    the scalar ``solve_target`` for the poses that need it. Returns how many poses fell back.
+    the scalar ``solve_target`` for the poses that need it and the scalar polish for the
+    candidates that need it. Returns how many poses needed either.
 
     targets: (N, 4, 4) rigid poses; reference (N, 5) or (1, 5) [rad]; outputs (N, B, ...), every
     slot written; solved (N,): an exact branch was found.
@@ -648,6 +656,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     ch = _chain_tuple(placements, axes)
     pr: Floats = to_fixed_tuple(prm, _N_PRM)  # type: ignore[call-arg]
     exact = prm[F.EXACT] != 0.0
+    lower, upper, tol = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5], prm[F.LIMIT_TOL]
     l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
     shape = (math.hypot(l20, l21), math.hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30))
@@ -689,6 +698,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     for k in range(3):
                         c[_C_Q + 1 + k, mc] = s[base + (_F_DOWN if elbow else _F_UP) + k, i]
                     c[_C_Q + 4, mc] = s[base + _F_Q5, i]
+                    for k in range(5):
+                        c[_C_START + k, mc] = c[_C_Q + k, mc]
                     c[_C_FOLD, mc] = s[base + _F_FOLD, i]
                     c[_C_FALL, mc] = 0.0
                     c[_C_PREV, mc] = 0.0
@@ -699,12 +710,15 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         if not exact:
             _polish_all(mc, ch, c_flat)
         _settle_all(mc, pr, ch, c_flat)
+        stop = start + m  # every slot empty, then the branches written
+        q_out[start:stop] = np.nan
+        valid[start:stop] = False
+        within[start:stop] = False
+        position_error[start:stop] = np.nan
+        orientation_error[start:stop] = np.nan
         for i in range(m):
             n = start + i
-            fall = s[_POSE_FALL, i] != 0.0
-            for k in range(first[i], first[i + 1]):
-                fall = fall or c[_C_FALL, k] != 0.0
-            if fall:
+            if s[_POSE_FALL, i] != 0.0:
                 fallbacks += 1
                 ref = reference[n if reference.shape[0] > 1 else 0]
                 solved[n] = solve_target(
@@ -719,20 +733,34 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     position_error[n, b] = out[b, POSITION_ERROR]
                     orientation_error[n, b] = out[b, ORIENTATION_ERROR]
                 continue
-            for b in range(nb):
-                for j in range(5):
-                    q_out[n, b, j] = np.nan
-                valid[n, b] = False
-                within[n, b] = False
-                position_error[n, b] = np.nan
-                orientation_error[n, b] = np.nan
             count = 0
+            scalar = False
             for k in range(first[i], first[i + 1]):
                 b = slot_of[k]
-                if c[_C_TAKE, k] == 0.0 or valid[n, b]:
+                if valid[n, b]:
                     continue
-                for j in range(5):
-                    qs[j] = c[_C_Q + j, k]
+                if c[_C_FALL, k] != 0.0:  # the scalar solver's polish of this candidate
+                    scalar = True
+                    for j in range(5):
+                        qs[j] = c[_C_START + j, k]
+                    current = False
+                    if not exact:
+                        current = polish_pose(
+                            placements, axes, targets[n], qs, pose, work, jac, origins, normal,
+                            vectors,
+                        )  # fmt: skip
+                    inside, err = settle(
+                        placements, axes, lower, upper, tol, targets[n], qs, pose, work, current
+                    )
+                    angle = rotation_angle(targets[n], pose)
+                    if not (err <= POSE_EXACT and angle <= POSE_EXACT):
+                        continue
+                else:
+                    if c[_C_TAKE, k] == 0.0:
+                        continue
+                    for j in range(5):
+                        qs[j] = c[_C_Q + j, k]
+                    inside, err, angle = c[_C_IN, k] != 0.0, c[_C_PERR, k], c[_C_OERR, k]
                 if is_duplicate(taken, _ALL_TAKEN, count, qs, DUPLICATE_TOLERANCE):
                     continue
                 for j in range(5):
@@ -740,8 +768,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     taken[count, j] = qs[j]
                 count += 1
                 valid[n, b] = True
-                within[n, b] = c[_C_IN, k] != 0.0
-                position_error[n, b] = c[_C_PERR, k]
-                orientation_error[n, b] = c[_C_OERR, k]
+                within[n, b] = inside
+                position_error[n, b] = err
+                orientation_error[n, b] = angle
             solved[n] = count > 0
+            fallbacks += 1 if scalar else 0
     return fallbacks
