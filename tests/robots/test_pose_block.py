@@ -17,7 +17,7 @@ import pytest
 
 from lynxplan.robots import Robot, load_robot
 from lynxplan.robots.ik import pose_kernel
-from lynxplan.robots.ik.pose_block import pose_block_kernel
+from lynxplan.robots.ik.pose_block import pose_block_kernel, smallest_errors
 from lynxplan.robots.results import BranchSlots
 from tests.robots.test_pose_kernel import _near_axis_poses
 from tests.robots.urdf_factory import write_random_family_urdfs
@@ -123,3 +123,27 @@ def test_vector_path_carries_the_load() -> None:
     poses = np.ascontiguousarray(robot.fk(robot.random_configurations(5000, seed=8)))
     _, _, fallbacks = _both(robot, poses, robot._default_reference)
     assert fallbacks <= 0.03 * len(poses)
+
+
+def test_smallest_errors_skips_empty_slots() -> None:
+    rng = np.random.default_rng(3)
+    errors = rng.uniform(0.0, 1.0, (500, 24))
+    errors[rng.uniform(size=errors.shape) < 0.7] = np.nan
+    errors[7] = np.nan
+    assert np.array_equal(smallest_errors(errors), np.fmin.reduce(errors, axis=1), equal_nan=True)
+
+
+def test_exact_branches_are_within_the_reach_tolerance() -> None:
+    """``solve_family`` returns the pose kernels' batch as it is when every target has exact
+    branches: each reaches its target within REACH_TOLERANCE (so it is reachable, and no
+    branch is dropped)."""
+    from lynxplan.robots.selection import REACH_TOLERANCE
+
+    assert pose_kernel.POSE_EXACT <= REACH_TOLERANCE
+    robot = load_robot("so101")
+    batch = robot.ik_batch(robot.fk(robot.random_configurations(300, seed=9)))
+    assert batch.reachable.all()
+    assert np.all(batch.position_error[batch.valid] <= REACH_TOLERANCE)
+    assert np.array_equal(
+        batch.distance, np.where(batch.valid, batch.position_error, np.inf).min(axis=1)
+    )

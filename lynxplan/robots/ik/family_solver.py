@@ -11,7 +11,7 @@ import numpy as np
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
-from lynxplan.robots.ik.pose_block import BLOCK, pose_block_kernel
+from lynxplan.robots.ik.pose_block import BLOCK, pose_block_kernel, smallest_errors
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
@@ -58,6 +58,15 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         rest = ~al5_fill(robot, target, reference, out)
     elif target.kind == fk_.MODE_POSE:
         rest = ~_pose_fill(robot, target, reference, out)
+        if not rest.any():  # every target has its exact branches, each within REACH_TOLERANCE
+            q, valid, within, perr, oerr = out
+            distance = smallest_errors(perr)
+            reachable = np.ones(n, dtype=np.bool_)
+            for array in (q, valid, within, perr, oerr, reachable, distance):
+                array.setflags(write=False)
+            return RobotIkBatch(
+                q, valid, within, perr, oerr, reachable, distance, branch_names(slots)
+            )
     if rest is None or rest.all():
         _kernel(robot, target, reference, out)
     elif rest.any():
