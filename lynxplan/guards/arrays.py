@@ -144,6 +144,15 @@ def poses(name: str, value: Any, *, batch: bool = True, approach_only: bool = Fa
     Returns:
         A C-contiguous float64 array of the input's shape.
     """
+    return poses_with_deviation(name, value, batch=batch, approach_only=approach_only)[0]
+
+
+def poses_with_deviation(
+    name: str, value: Any, *, batch: bool = True, approach_only: bool = False
+) -> tuple[np.ndarray, float]:
+    """:func:`poses`, and the largest deviation of their rotation blocks from orthonormal
+    (``max |R^T R - I|``, within the repair tolerance; 0 with ``approach_only``), found by the
+    same pass."""
     array = _as_float64(name, value)
     if array.shape == (3, 3) or (batch and array.ndim == 3 and array.shape[1:] == (3, 3)):
         raise ShapeError(
@@ -161,7 +170,7 @@ def poses(name: str, value: Any, *, batch: bool = True, approach_only: bool = Fa
         check_size(f"{name}: poses in one batch", stack.shape[0])
     k, code, detail = pose_check_kernel(stack, MAX_ABS_LENGTH, approach_only).tolist()
     if code == POSE_OK:
-        return stack if array.ndim == 3 else stack[0]
+        return (stack if array.ndim == 3 else stack[0]), detail
     at = f"{name}[{int(k)}]" if array.ndim == 3 else name
     if code == POSE_NON_FINITE:
         raise NonFiniteInputError(name, f"in {at}")

@@ -30,8 +30,11 @@ def pose_check_kernel(T: np.ndarray, max_length: float, approach_only: bool) -> 
 
 
 def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.ndarray:
-    """First bad pose of ``T`` (N, 4, 4): ``[index, code, detail]`` (code 0: all good)."""
+    """First bad pose of ``T`` (N, 4, 4): ``[index, code, detail]``; code 0: all good, and the
+    detail is then the largest deviation of a rotation block from orthonormal (0 with
+    ``approach_only``)."""
     out = np.zeros(3)
+    worst = 0.0
     for k in range(T.shape[0]):
         t = T[k]
         for i in range(4):
@@ -61,6 +64,7 @@ def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.nda
         if deviation > RIGIDITY_REPAIR_TOLERANCE:
             out[0], out[1], out[2] = k, POSE_NOT_ORTHONORMAL, deviation
             return out
+        worst = max(worst, deviation)
         det = (
             t[0, 0] * (t[1, 1] * t[2, 2] - t[1, 2] * t[2, 1])
             - t[0, 1] * (t[1, 0] * t[2, 2] - t[1, 2] * t[2, 0])
@@ -69,4 +73,5 @@ def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.nda
         if det < 0.0:
             out[0], out[1], out[2] = k, POSE_REFLECTION, det
             return out
+    out[2] = worst
     return out

@@ -38,9 +38,12 @@ def _rigid_poses(poses: Any) -> np.ndarray:
     """Full target poses (N, 4, 4): checked by ``lynxplan.guards.poses`` (finite, in range,
     last row 0 0 0 1, rotation within the repair tolerance of proper orthonormal), then
     rotation blocks off orthonormal replaced by the nearest rotation (polar decomposition)."""
-    from lynxplan.guards import poses as checked_poses
+    from lynxplan.guards.arrays import poses_with_deviation
 
-    array = np.array(checked_poses("pose", poses), dtype=float).reshape(-1, 4, 4)
+    checked, deviation = poses_with_deviation("pose", poses)
+    if deviation <= ORTHONORMAL_TOLERANCE:  # the common case: nothing to repair
+        return checked.reshape(-1, 4, 4)
+    array = np.array(checked, dtype=float).reshape(-1, 4, 4)
     rotations = array[:, :3, :3]
     gram = np.einsum("nji,njk->nik", rotations, rotations) - np.eye(3)
     off = np.abs(gram).max(axis=(1, 2)) > ORTHONORMAL_TOLERANCE

@@ -162,3 +162,25 @@ def test_full_pose_targets_must_be_rigid(name: str) -> None:
     nudged[0, 0] += 1e-7  # within the repair tolerance: the nearest rotation is solved
     result = robot.ik(nudged)
     assert result.solutions and result.orientation_residual < 1e-6
+
+
+def test_a_batch_with_one_pose_off_orthonormal_is_repaired_there_only() -> None:
+    """The guards report the largest deviation from orthonormal (the same as numpy's
+    ``max |R^T R - I|``); a batch is repaired only where a pose is off, and its solutions are
+    the batch's without that pose."""
+    from lynxplan.guards.arrays import poses_with_deviation
+    from lynxplan.robots.targets import _rigid_poses
+
+    robot = load_robot("so101")
+    poses = robot.fk(robot.random_configurations(100, seed=22))
+    nudged = poses.copy()
+    nudged[37, 0, 0] += 1e-7
+    _, deviation = poses_with_deviation("pose", nudged)
+    rotations = nudged[:, :3, :3]
+    gram = np.einsum("nji,njk->nik", rotations, rotations) - np.eye(3)
+    assert deviation == pytest.approx(np.abs(gram).max(), rel=1e-12)
+    repaired = _rigid_poses(nudged)
+    assert np.array_equal(np.delete(repaired, 37, 0), np.delete(poses, 37, 0))
+    r = repaired[37, :3, :3]
+    assert np.abs(r.T @ r - np.eye(3)).max() < 1e-15
+    assert np.abs(r - poses[37, :3, :3]).max() < 1e-7

@@ -11,6 +11,7 @@ import numpy as np
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
+from lynxplan.robots.ik.pose_block import BLOCK, pose_block_kernel, smallest_errors
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
@@ -57,6 +58,15 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         rest = ~al5_fill(robot, target, reference, out)
     elif target.kind == fk_.MODE_POSE:
         rest = ~_pose_fill(robot, target, reference, out)
+        if not rest.any():  # every target has its exact branches, each within REACH_TOLERANCE
+            q, valid, within, perr, oerr = out
+            distance = smallest_errors(perr)
+            reachable = np.ones(n, dtype=np.bool_)
+            for array in (q, valid, within, perr, oerr, reachable, distance):
+                array.setflags(write=False)
+            return RobotIkBatch(
+                q, valid, within, perr, oerr, reachable, distance, branch_names(slots)
+            )
     if rest is None or rest.all():
         _kernel(robot, target, reference, out)
     elif rest.any():
@@ -226,12 +236,14 @@ def solve_pose_one(
 
 
 def _pose_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> np.ndarray:
-    """Full poses the orientation solves in closed form (``pose_kernel``); returns which. The
-    others (out of reach, degenerate, a given roll) need the general kernel (root search)."""
+    """Full poses the orientation solves in closed form (``pose_kernel``; from a block of poses
+    on, its vectorised form ``pose_block``); returns which. The others (out of reach,
+    degenerate, a given roll) need the general kernel (root search)."""
     family = robot.family
     assert family is not None
     solved = np.empty(target.poses.shape[0], dtype=np.bool_)
-    _pk.pose_kernel(
+    kernel = pose_block_kernel if target.poses.shape[0] >= BLOCK else _pk.pose_kernel
+    kernel(
         family.packed,
         robot.chain.placements,
         robot.chain.axes,

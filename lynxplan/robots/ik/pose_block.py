@@ -1,0 +1,791 @@
+"""Numba kernel: the full-pose solver of ``pose_kernel`` over blocks of poses, vectorised.
+
+The same solution as :func:`lynxplan.robots.ik.pose_kernel.solve_target` (read its docstring
+for the geometry), laid out for SIMD: a block of :data:`BLOCK` poses is transposed into scratch
+rows (one row per quantity, one column per pose) and each candidate branch (flip of the yaw,
+elbow) is solved for the whole block by one loop without branches or calls, which LLVM turns
+into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
+
+1. the closed form on the ideal model (yaw, pitch sum, roll, the side of the lateral offset
+   whose yaw matches, the two-link shoulder and elbow);
+2. on a model only close to the family, a fixed polish on the exact chain: one Gauss-Newton step
+   (pose and geometric Jacobian, the normal equations by an LDL^T factorisation), then
+   two chord steps with the same factors (from ~1e-6 away the error falls to ~1e-12, then
+   ~1e-18; the second step settles the candidates that start farther away);
+3. the angles wrapped into the joint limits, and the pose of the exact chain at the final
+   angles: the position and orientation errors that are reported.
+
+A candidate is *taken* here only when its final errors are below :data:`VECTOR_EXACT` (far below
+``POSE_EXACT``), and *rejected* (not an exact branch) when its error stopped falling far above
+that. Any other candidate (still converging: next to a fold of the elbow Newton converges
+linearly; or an ill-conditioned polish) is finished by the scalar solver's own polish
+(``pose_kernel.polish_pose``) from its closed-form start, exactly as ``solve_target`` treats it.
+A pose where anything is unusual goes to the scalar ``solve_target``, whole: a near fold of a
+near-family model (where the scalar solver starts the elbows apart), both sides of the lateral
+offset matching the yaw, the approach along the yaw or the pitch axis, the target on the yaw
+axis, or anything not finite. The fixed steps never decide alone that a branch does not exist
+unless the candidate has stalled. Slots, validity and duplicates follow the scalar solver's
+order, so both give the same branches (angles equal to ~1e-10 rad).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+from numba import literal_unroll
+from numba.np.unsafe.ndarray import to_fixed_tuple
+
+from lynxplan import _fastmath
+from lynxplan.arm.ik_kernel import wrap_into_limits
+from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
+from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
+from lynxplan.robots.ik.pose_kernel import (
+    AXIAL_APPROACH,
+    ORIENTATION_ERROR,
+    POSE_EXACT,
+    POSITION_ERROR,
+    REACH_MISS,
+    SLOT_COLUMNS,
+    VALID,
+    WITHIN,
+    YAW_MATCH,
+    YAW_MATCH_LENGTH,
+    polish_pose,
+    solve_target,
+)
+
+_FAST = {"contract", "arcp"}
+#: Floats in registers: a pose (12, row-major 3 x 4), a Jacobian column (6), the parameters.
+Floats = tuple[float, ...]
+#: One flip's branches: q1, (q2, q3, q4) elbow up, (q2, q3, q4) elbow down, q5, candidate,
+#: fallback, side, near a fold.
+FlipBranches = tuple[float, Floats, Floats, float, bool, bool, float, bool]
+# The branch-free sine/cosine and arctangent, inlined by LLVM rather than by numba: numba's own
+# inlining (``inline="always"``) of their ~40 call sites would multiply the compile time by 5.
+sincos = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.sincos.py_func)
+atan2 = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.atan2.py_func)
+#: Poses per block (a constant width: the scratch rows never alias, see ``arm.ik_kernel``).
+BLOCK = 32
+#: A candidate is taken by the vector path when its final position [m] and orientation [rad]
+#: errors are both below this; otherwise its pose goes to the scalar solver.
+VECTOR_EXACT = 1e-14
+#: A candidate whose final position [m] or orientation [rad] error is above NOT_A_BRANCH and has
+#: stopped falling (at least STALLED times the error before the last chord step) is not an exact
+#: branch: the orientation is out of reach on that flip, and the steps end at the residual of the
+#: nearest orientation (~1e-4), as the scalar polish does, which rejects it too. A candidate
+#: still falling there, or next to a fold of the elbow (where the chord steps stall before Newton's
+#: would: the roots are close), falls back.
+NOT_A_BRANCH, STALLED = 1e-6, 0.5
+#: Next to a fold: |cos| of the elbow angle within this of 1 (an elbow ~0.045 rad from straight).
+FOLD_BAND = 1e-3
+#: The polish's normal matrix this ill-conditioned (smallest over largest LDL^T pivot) falls back.
+ILL_CONDITIONED = 1e-8
+_TWO_PI = 2.0 * math.pi
+_N_CHAIN = 6 * 12  # the 3 x 4 blocks of M'_1..M'_5, M'_tool (see ``_chain_tuple``)
+_N_PRM = F.N_PARAMS
+
+# Pose scratch rows: the target (row-major 3 x 4), then per flip: q1, (q2, q3, q4) of elbow up
+# and of elbow down, q5, candidate, fallback, side, near a fold (1/0); the pose's fallback.
+_FLIP0 = 12
+_F_Q1, _F_UP, _F_DOWN, _F_Q5, _F_CAND, _F_FALL, _F_SIDE, _F_FOLD = 0, 1, 4, 7, 8, 9, 10, 11
+_PER_FLIP = 12
+_POSE_FALL = _FLIP0 + 2 * _PER_FLIP
+_ROWS = _POSE_FALL + 1
+# Candidate scratch rows (up to 4 per pose): the target (12), q (5), near a fold, the error
+# before the last chord step, then taken, fallback, within (1/0), position, orientation error,
+# and the closed-form q (5).
+_C_Q, _C_FOLD, _C_PREV, _C_TAKE, _C_FALL, _C_IN, _C_PERR, _C_OERR = 12, 17, 18, 19, 20, 21, 22, 23
+_C_START = 24  # the closed-form q (5), where a candidate that falls back starts
+_C_ROWS = 29
+_CW = 4 * BLOCK  # the candidate rows' width
+_ALL_TAKEN = np.ones(4, dtype=np.bool_)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _acos(x: float) -> float:
+    """arccos of x in [-1, 1] (an atan2: accurate at the ends too, no branch)."""
+    return atan2(math.sqrt((1.0 - x) * (1.0 + x)), x)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _wrap(x: float) -> float:
+    return x - _TWO_PI * math.floor((x + math.pi) / _TWO_PI)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _rot(
+    u0: float, u1: float, u2: float, c: float, s: float, v0: float, v1: float, v2: float
+) -> tuple[float, float, float]:
+    """Rodrigues: v rotated by the angle with cosine c and sine s about the unit axis u."""
+    d = (u0 * v0 + u1 * v1 + u2 * v2) * (1.0 - c)
+    return (
+        v0 * c + (u1 * v2 - u2 * v1) * s + u0 * d,
+        v1 * c + (u2 * v0 - u0 * v2) * s + u1 * d,
+        v2 * c + (u0 * v1 - u1 * v0) * s + u2 * d,
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _pitch_sum(pr: Floats, a0: float, a1: float, a2: float, phi: float) -> tuple[float, bool]:
+    """Canonical pitch sum for yaw phi and approach a, and whether it is degenerate (the
+    approach along the pitch axis)."""
+    s, c = sincos(phi)
+    ap = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
+    ah = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
+    ak = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
+    x = c * ah - s * ap
+    return atan2(ak, x) - pr[F.GAMMA0], math.sqrt(x * x + ak * ak) <= 1e-12
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _best_roll(pr: Floats, g: Floats, phi: float, big_phi: float) -> float:
+    """Canonical roll nearest the target (``family_geometry.best_roll``); g: the 9 entries of
+    G = Rt Rt0^T, row-major."""
+    sy, cy = sincos(-phi)
+    sp, cp = sincos(-big_phi)
+    k0, k1, k2 = pr[F.K], pr[F.K + 1], pr[F.K + 2]
+    p0, p1, p2 = pr[F.P], pr[F.P + 1], pr[F.P + 2]
+    r0, r1, r2 = pr[F.R], pr[F.R + 1], pr[F.R + 2]
+    x0, x1, x2 = _rot(k0, k1, k2, cy, sy, g[0], g[3], g[6])
+    m00, m10, m20 = _rot(p0, p1, p2, cp, sp, x0, x1, x2)
+    x0, x1, x2 = _rot(k0, k1, k2, cy, sy, g[1], g[4], g[7])
+    m01, m11, m21 = _rot(p0, p1, p2, cp, sp, x0, x1, x2)
+    x0, x1, x2 = _rot(k0, k1, k2, cy, sy, g[2], g[5], g[8])
+    m02, m12, m22 = _rot(p0, p1, p2, cp, sp, x0, x1, x2)
+    sine = r0 * (m21 - m12) + r1 * (m02 - m20) + r2 * (m10 - m01)
+    rmr = (
+        r0 * (m00 * r0 + m01 * r1 + m02 * r2)
+        + r1 * (m10 * r0 + m11 * r1 + m12 * r2)
+        + r2 * (m20 * r0 + m21 * r1 + m22 * r2)
+    )
+    return atan2(sine, m00 + m11 + m22 - rmr)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _yaw(
+    pr: Floats, dp: float, dh: float, rho: float, theta: float, side: int
+) -> tuple[float, float, bool]:
+    """Yaw of one side for roll theta (``family_geometry.yaw``), its lateral miss [m], and
+    whether the target is on the yaw axis (left to the scalar solver)."""
+    st, ct = sincos(theta)
+    lat = pr[F.LAM4] + pr[F.W0 + 2] + ct * pr[F.E1 + 2] + st * pr[F.E2 + 2]
+    on_axis = (rho <= 1e-12) & (abs(lat) <= 1e-12)
+    ratio = lat / rho if rho > 0.0 else math.copysign(1.0, lat)
+    miss = lat - rho if ratio > 1.0 else 0.0
+    miss = -lat - rho if ratio < -1.0 else miss
+    ratio = min(max(ratio, -1.0), 1.0)
+    beta = _acos(ratio)
+    alpha = atan2(dh, dp)
+    return (alpha + beta if side == 1 else alpha - beta), miss, on_axis
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # noqa: PLR0915
+    """The closed-form branches of one flip of the yaw (both elbows) of the target t (12:
+    row-major 3 x 4) on the ideal model: (q1, (q2, q3, q4) of elbow up, the same of elbow down,
+    q5, candidate, fallback, side, near a fold of the elbow); shape: (la, lb, b2, b3) of the
+    two links (``family_geometry.two_link``)."""
+    rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
+          pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
+    g0 = t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]
+    g1 = t[0] * rt[3] + t[1] * rt[4] + t[2] * rt[5]
+    g2 = t[0] * rt[6] + t[1] * rt[7] + t[2] * rt[8]
+    g3 = t[4] * rt[0] + t[5] * rt[1] + t[6] * rt[2]
+    g4 = t[4] * rt[3] + t[5] * rt[4] + t[6] * rt[5]
+    g5 = t[4] * rt[6] + t[5] * rt[7] + t[6] * rt[8]
+    g6 = t[8] * rt[0] + t[9] * rt[1] + t[10] * rt[2]
+    g7 = t[8] * rt[3] + t[9] * rt[4] + t[10] * rt[5]
+    g8 = t[8] * rt[6] + t[9] * rt[7] + t[10] * rt[8]
+    g = (g0, g1, g2, g3, g4, g5, g6, g7, g8)
+    a0 = g0 * pr[F.R] + g1 * pr[F.R + 1] + g2 * pr[F.R + 2]
+    a1 = g3 * pr[F.R] + g4 * pr[F.R + 1] + g5 * pr[F.R + 2]
+    a2 = g6 * pr[F.R] + g7 * pr[F.R + 1] + g8 * pr[F.R + 2]
+    a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
+    a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
+    axial = math.sqrt(a_h * a_h + a_p * a_p) <= AXIAL_APPROACH
+    d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
+    dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
+    dh = d0 * pr[F.H] + d1 * pr[F.H + 1] + d2 * pr[F.H + 2]
+    dk = d0 * pr[F.K] + d1 * pr[F.K + 1] + d2 * pr[F.K + 2]
+    rho = math.sqrt(dp * dp + dh * dh)
+    match = YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12)
+    phi = atan2(-a_p, a_h) + flip * math.pi
+    big_phi, flat1 = _pitch_sum(pr, a0, a1, a2, phi)
+    theta = _best_roll(pr, g, phi, big_phi)
+    yaw0, lat_miss, on_axis = _yaw(pr, dp, dh, rho, theta, 0)
+    yaw1, _, _ = _yaw(pr, dp, dh, rho, theta, 1)
+    lat_ok = lat_miss <= REACH_MISS
+    ok0 = lat_ok & (abs(_wrap(yaw0 - phi)) <= match)
+    ok1 = lat_ok & (abs(_wrap(yaw1 - phi)) <= match)
+    side = 1.0 if ok1 else 0.0
+    phi2 = yaw1 if ok1 else yaw0
+    big2, flat2 = _pitch_sum(pr, a0, a1, a2, phi2)
+    theta = _best_roll(pr, g, phi2, big2) if pr[F.OFF_AXIS] == 0.0 else theta
+    s2, c2 = sincos(phi2)
+    x, y = c2 * dh - s2 * dp, dk
+    st, ct = sincos(theta)
+    wh = pr[F.W0] + ct * pr[F.E1] + st * pr[F.E2]
+    wk = pr[F.W0 + 1] + ct * pr[F.E1 + 1] + st * pr[F.E2 + 1]
+    sp, cp = sincos(big2)
+    la, lb, b2, b3 = shape
+    rx = x - (cp * wh - sp * wk) - pr[F.O2]
+    ry = y - (sp * wh + cp * wk) - pr[F.O2 + 1]
+    dist = math.sqrt(rx * rx + ry * ry)
+    cosd = (dist * dist - la * la - lb * lb) / (2.0 * la * lb)
+    reach = dist - (la + lb) if cosd > 1.0 else 0.0
+    reach = abs(la - lb) - dist if cosd < -1.0 else reach
+    cosd = min(max(cosd, -1.0), 1.0)
+    # where the scalar solver starts the two elbows apart (a near-family model): its result
+    fold_start = (pr[F.EXACT] == 0.0) & (abs(cosd) > 1.0 - 1e-6)
+    fold = abs(cosd) > 1.0 - FOLD_BAND
+    delta = _acos(cosd)
+    sd, cd = sincos(delta)
+    toward = atan2(ry, rx)
+    bend = atan2(lb * sd, la + lb * cd)
+    miss = math.sqrt(reach * reach + lat_miss * lat_miss)
+    candidate = (ok0 | ok1) & (miss <= REACH_MISS)
+    finite = math.isfinite(d0 + d1 + d2 + a0 + a1 + a2 + g0 + g4 + g8)
+    fallback = axial | flat1 | flat2 | on_axis | (ok0 & ok1) | (candidate & fold_start)
+    fallback |= not finite
+    # elbow up (0): the elbow above the shoulder-wrist line, the elbow angle -delta
+    up2, down2 = toward + bend - b2, toward - bend - b2
+    up3, down3 = b2 - b3 - delta, b2 - b3 + delta
+    return (
+        pr[F.SIGMA] * phi2,
+        (pr[F.SIGMA + 1] * up2, pr[F.SIGMA + 2] * up3, pr[F.SIGMA + 3] * (big2 - up2 - up3)),
+        (
+            pr[F.SIGMA + 1] * down2,
+            pr[F.SIGMA + 2] * down3,
+            pr[F.SIGMA + 3] * (big2 - down2 - down3),
+        ),
+        pr[F.SIGMA + 4] * theta,
+        candidate,
+        fallback,
+        side,
+        fold,
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _joint(ch: Floats, j: int, t: Floats, q: float) -> Floats:
+    """The running pose t (12: row-major 3 x 4) times R(z, q) M'_{j+1}; ch: the chain tuple
+    (``_chain_tuple``: every joint turned about its own z axis)."""
+    s, c = sincos(q)
+    w00, w01 = c * t[0] + s * t[1], c * t[1] - s * t[0]
+    w10, w11 = c * t[4] + s * t[5], c * t[5] - s * t[4]
+    w20, w21 = c * t[8] + s * t[9], c * t[9] - s * t[8]
+    w02, w12, w22 = t[2], t[6], t[10]
+    b = 12 * (j + 1)
+    m00, m01, m02, m03 = ch[b], ch[b + 1], ch[b + 2], ch[b + 3]
+    m10, m11, m12, m13 = ch[b + 4], ch[b + 5], ch[b + 6], ch[b + 7]
+    m20, m21, m22, m23 = ch[b + 8], ch[b + 9], ch[b + 10], ch[b + 11]
+    return (
+        w00 * m00 + w01 * m10 + w02 * m20,
+        w00 * m01 + w01 * m11 + w02 * m21,
+        w00 * m02 + w01 * m12 + w02 * m22,
+        w00 * m03 + w01 * m13 + w02 * m23 + t[3],
+        w10 * m00 + w11 * m10 + w12 * m20,
+        w10 * m01 + w11 * m11 + w12 * m21,
+        w10 * m02 + w11 * m12 + w12 * m22,
+        w10 * m03 + w11 * m13 + w12 * m23 + t[7],
+        w20 * m00 + w21 * m10 + w22 * m20,
+        w20 * m01 + w21 * m11 + w22 * m21,
+        w20 * m02 + w21 * m12 + w22 * m22,
+        w20 * m03 + w21 * m13 + w22 * m23 + t[11],
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _axis_of(t: Floats) -> Floats:
+    """A joint's origin and world axis (its z axis) from the running pose t before its
+    rotation."""
+    return t[3], t[7], t[11], t[2], t[6], t[10]
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _fk(ch: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
+    """Tool pose (12: row-major 3 x 4) of the chain at q."""
+    t: Floats = (
+        ch[0],
+        ch[1],
+        ch[2],
+        ch[3],
+        ch[4],
+        ch[5],
+        ch[6],
+        ch[7],
+        ch[8],
+        ch[9],
+        ch[10],
+        ch[11],
+    )
+    t = _joint(ch, 0, t, q0)
+    t = _joint(ch, 1, t, q1)
+    t = _joint(ch, 2, t, q2)
+    t = _joint(ch, 3, t, q3)
+    return _joint(ch, 4, t, q4)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _column(o: Floats, p: Floats) -> Floats:
+    """Geometric Jacobian column (6) of a joint with origin/axis o (6) for the tool point p."""
+    dx, dy, dz = p[3] - o[0], p[7] - o[1], p[11] - o[2]
+    wx, wy, wz = o[3], o[4], o[5]
+    return (wy * dz - wz * dy, wz * dx - wx * dz, wx * dy - wy * dx, wx, wy, wz)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _error(p: Floats, t: Floats) -> Floats:
+    """Pose error (6) of p against the target t (both 12, row-major 3 x 4): the position
+    difference [m] and vee(R Rt^T - Rt R^T) / 2 [rad]."""
+    m01 = p[0] * t[4] + p[1] * t[5] + p[2] * t[6]
+    m10 = p[4] * t[0] + p[5] * t[1] + p[6] * t[2]
+    m02 = p[0] * t[8] + p[1] * t[9] + p[2] * t[10]
+    m20 = p[8] * t[0] + p[9] * t[1] + p[10] * t[2]
+    m12 = p[4] * t[8] + p[5] * t[9] + p[6] * t[10]
+    m21 = p[8] * t[4] + p[9] * t[5] + p[10] * t[6]
+    return (
+        p[3] - t[3],
+        p[7] - t[7],
+        p[11] - t[11],
+        0.5 * (m21 - m12),
+        0.5 * (m02 - m20),
+        0.5 * (m10 - m01),
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _dot6(a: Floats, b: Floats) -> float:
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3] + a[4] * b[4] + a[5] * b[5]
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _ldl(
+    j0: Floats, j1: Floats, j2: Floats, j3: Floats, j4: Floats
+) -> tuple[Floats, Floats, float]:
+    """LDL^T factors of J^T J for the Jacobian columns j0..j4 (6 each): the strict lower
+    triangle (10, row-major) and the inverse pivots (5)."""
+    n00, n11, n22, n33, n44 = (
+        _dot6(j0, j0),
+        _dot6(j1, j1),
+        _dot6(j2, j2),
+        _dot6(j3, j3),
+        _dot6(j4, j4),
+    )
+    n10, n20, n30, n40 = _dot6(j1, j0), _dot6(j2, j0), _dot6(j3, j0), _dot6(j4, j0)
+    n21, n31, n41 = _dot6(j2, j1), _dot6(j3, j1), _dot6(j4, j1)
+    n32, n42, n43 = _dot6(j3, j2), _dot6(j4, j2), _dot6(j4, j3)
+    d0 = n00
+    i0 = 1.0 / d0
+    l10, l20, l30, l40 = n10 * i0, n20 * i0, n30 * i0, n40 * i0
+    d1 = n11 - l10 * l10 * d0
+    i1 = 1.0 / d1
+    l21 = (n21 - l20 * l10 * d0) * i1
+    l31 = (n31 - l30 * l10 * d0) * i1
+    l41 = (n41 - l40 * l10 * d0) * i1
+    d2 = n22 - l20 * l20 * d0 - l21 * l21 * d1
+    i2 = 1.0 / d2
+    l32 = (n32 - l30 * l20 * d0 - l31 * l21 * d1) * i2
+    l42 = (n42 - l40 * l20 * d0 - l41 * l21 * d1) * i2
+    d3 = n33 - l30 * l30 * d0 - l31 * l31 * d1 - l32 * l32 * d2
+    i3 = 1.0 / d3
+    l43 = (n43 - l40 * l30 * d0 - l41 * l31 * d1 - l42 * l32 * d2) * i3
+    d4 = n44 - l40 * l40 * d0 - l41 * l41 * d1 - l42 * l42 * d2 - l43 * l43 * d3
+    i4 = 1.0 / d4
+    ratio = min(d0, d1, d2, d3, d4) / max(d0, d1, d2, d3, d4)
+    return (l10, l20, l21, l30, l31, l32, l40, l41, l42, l43), (i0, i1, i2, i3, i4), ratio
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _step(
+    lower: Floats,
+    inverse: Floats,
+    j0: Floats,
+    j1: Floats,
+    j2: Floats,
+    j3: Floats,
+    j4: Floats,
+    e: Floats,
+) -> Floats:
+    """The Gauss-Newton step x = (J^T J)^-1 J^T e from the LDL^T factors (``_ldl``)."""
+    l10, l20, l21, l30, l31, l32, l40, l41, l42, l43 = lower
+    y0 = _dot6(j0, e)
+    y1 = _dot6(j1, e) - l10 * y0
+    y2 = _dot6(j2, e) - l20 * y0 - l21 * y1
+    y3 = _dot6(j3, e) - l30 * y0 - l31 * y1 - l32 * y2
+    y4 = _dot6(j4, e) - l40 * y0 - l41 * y1 - l42 * y2 - l43 * y3
+    x4 = y4 * inverse[4]
+    x3 = y3 * inverse[3] - l43 * x4
+    x2 = y2 * inverse[2] - l32 * x3 - l42 * x4
+    x1 = y1 * inverse[1] - l21 * x2 - l31 * x3 - l41 * x4
+    x0 = y0 * inverse[0] - l10 * x1 - l20 * x2 - l30 * x3 - l40 * x4
+    return x0, x1, x2, x3, x4
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _chord(
+    ch: Floats,
+    t: Floats,
+    lower: Floats,
+    inverse: Floats,
+    jac: tuple[Floats, ...],
+    q0: float,
+    q1: float,
+    q2: float,
+    q3: float,
+    q4: float,
+) -> Floats:
+    """One chord step: q minus the step for the pose error at q with the kept factors; and
+    the largest component of that error."""
+    e = _error(_fk(ch, q0, q1, q2, q3, q4), t)
+    size = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]), abs(e[5]))
+    x = _step(lower, inverse, jac[0], jac[1], jac[2], jac[3], jac[4], e)
+    return q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4], size
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
+    """One Gauss-Newton step and two chord steps on the exact chain from q: the final q,
+    the smallest over the largest LDL^T pivot of J^T J (its conditioning), and the largest
+    component of the pose error before the last chord step."""
+    p: Floats = (
+        ch[0],
+        ch[1],
+        ch[2],
+        ch[3],
+        ch[4],
+        ch[5],
+        ch[6],
+        ch[7],
+        ch[8],
+        ch[9],
+        ch[10],
+        ch[11],
+    )
+    o0 = _axis_of(p)
+    p = _joint(ch, 0, p, q0)
+    o1 = _axis_of(p)
+    p = _joint(ch, 1, p, q1)
+    o2 = _axis_of(p)
+    p = _joint(ch, 2, p, q2)
+    o3 = _axis_of(p)
+    p = _joint(ch, 3, p, q3)
+    o4 = _axis_of(p)
+    p = _joint(ch, 4, p, q4)
+    j0, j1, j2 = _column(o0, p), _column(o1, p), _column(o2, p)
+    j3, j4 = _column(o3, p), _column(o4, p)
+    lower, inverse, ratio = _ldl(j0, j1, j2, j3, j4)
+    x = _step(lower, inverse, j0, j1, j2, j3, j4, _error(p, t))
+    q0, q1, q2, q3, q4 = q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4]
+    jac = (j0, j1, j2, j3, j4)
+    q0, q1, q2, q3, q4, _ = _chord(ch, t, lower, inverse, jac, q0, q1, q2, q3, q4)
+    q0, q1, q2, q3, q4, size = _chord(ch, t, lower, inverse, jac, q0, q1, q2, q3, q4)
+    return q0, q1, q2, q3, q4, ratio, size
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _rotation_angle(p: Floats, t: Floats) -> float:
+    """Angle of the rotation from t's to p's rotation block [rad] (``rotation_angle``)."""
+    tr = t[0] * p[0] + t[4] * p[4] + t[8] * p[8] + t[1] * p[1] + t[5] * p[5] + t[9] * p[9]
+    tr += t[2] * p[2] + t[6] * p[6] + t[10] * p[10]
+    m01 = t[0] * p[1] + t[4] * p[5] + t[8] * p[9]
+    m10 = t[1] * p[0] + t[5] * p[4] + t[9] * p[8]
+    m02 = t[0] * p[2] + t[4] * p[6] + t[8] * p[10]
+    m20 = t[2] * p[0] + t[6] * p[4] + t[10] * p[8]
+    m12 = t[1] * p[2] + t[5] * p[6] + t[9] * p[10]
+    m21 = t[2] * p[1] + t[6] * p[5] + t[10] * p[9]
+    s0, s1, s2 = m21 - m12, m02 - m20, m10 - m01
+    return atan2(0.5 * math.sqrt(s0 * s0 + s1 * s1 + s2 * s2), 0.5 * (tr - 1.0))
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _closed_forms(m: int, pr: Floats, shape: Floats, s: np.ndarray) -> None:
+    """Both flips and elbows of the block's m poses in the scratch rows s (flat: row k is
+    s[k * BLOCK:], at distances LLVM sees, so it needs no aliasing checks): one loop, no branch
+    and no call (see the module docstring)."""
+    for i in range(m):
+        t = _column_of(s, BLOCK, 0, i)
+        for flip in literal_unroll((0, 1)):
+            q1, up, down, q5, cand, fall, side, fold = _flip(pr, shape, t, flip)
+            base = (_FLIP0 + flip * _PER_FLIP) * BLOCK + i
+            s[base + _F_Q1 * BLOCK] = q1
+            s[base + _F_UP * BLOCK] = up[0]
+            s[base + (_F_UP + 1) * BLOCK] = up[1]
+            s[base + (_F_UP + 2) * BLOCK] = up[2]
+            s[base + _F_DOWN * BLOCK] = down[0]
+            s[base + (_F_DOWN + 1) * BLOCK] = down[1]
+            s[base + (_F_DOWN + 2) * BLOCK] = down[2]
+            s[base + _F_Q5 * BLOCK] = q5
+            s[base + _F_CAND * BLOCK] = 1.0 if cand else 0.0
+            s[base + _F_FALL * BLOCK] = 1.0 if fall else 0.0
+            s[base + _F_SIDE * BLOCK] = side
+            s[base + _F_FOLD * BLOCK] = 1.0 if fold else 0.0
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _column_of(rows: np.ndarray, width: int, first: int, i: int) -> Floats:
+    """The 12 values rows[(first + k) * width + i], k = 0..11 (a target, row-major 3 x 4)."""
+    b = first * width + i
+    return (
+        rows[b], rows[b + width], rows[b + 2 * width], rows[b + 3 * width],
+        rows[b + 4 * width], rows[b + 5 * width], rows[b + 6 * width], rows[b + 7 * width],
+        rows[b + 8 * width], rows[b + 9 * width], rows[b + 10 * width], rows[b + 11 * width],
+    )  # fmt: skip
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _angles_of(c: np.ndarray, i: int) -> Floats:
+    """Candidate i's five angles from the candidate rows c."""
+    b = _C_Q * _CW + i
+    return c[b], c[b + _CW], c[b + 2 * _CW], c[b + 3 * _CW], c[b + 4 * _CW]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _put_angles(
+    c: np.ndarray, i: int, q0: float, q1: float, q2: float, q3: float, q4: float
+) -> None:
+    """Candidate i's five angles into the candidate rows c."""
+    b = _C_Q * _CW + i
+    c[b], c[b + _CW], c[b + 2 * _CW], c[b + 3 * _CW], c[b + 4 * _CW] = q0, q1, q2, q3, q4
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _polish_all(m: int, ch: Floats, c: np.ndarray) -> None:
+    """The polish of the m candidates in the rows c (flat: row k is c[k * _CW:]; a model only
+    close to the family): q in place, the fallback flag where the normal matrix is
+    ill-conditioned, the error before the last chord step."""
+    for i in range(m):
+        t = _column_of(c, _CW, 0, i)
+        q0, q1, q2, q3, q4 = _angles_of(c, i)
+        q0, q1, q2, q3, q4, ratio, size = _polish(ch, t, q0, q1, q2, q3, q4)
+        _put_angles(c, i, q0, q1, q2, q3, q4)
+        c[_C_FALL * _CW + i] = 0.0 if ratio >= ILL_CONDITIONED else 1.0
+        c[_C_PREV * _CW + i] = size
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
+    """The m candidates' angles wrapped into the limits, their errors at the final angles, and
+    the verdict: taken, fallback (see the module docstring), or neither (not a branch)."""
+    tol = pr[F.LIMIT_TOL]
+    lo = (pr[F.LOWER], pr[F.LOWER + 1], pr[F.LOWER + 2], pr[F.LOWER + 3], pr[F.LOWER + 4])
+    hi = (pr[F.UPPER], pr[F.UPPER + 1], pr[F.UPPER + 2], pr[F.UPPER + 3], pr[F.UPPER + 4])
+    for i in range(m):
+        t = _column_of(c, _CW, 0, i)
+        q0, q1, q2, q3, q4 = _angles_of(c, i)
+        q0, in0 = wrap_into_limits(q0, lo[0], hi[0], tol)
+        q1, in1 = wrap_into_limits(q1, lo[1], hi[1], tol)
+        q2, in2 = wrap_into_limits(q2, lo[2], hi[2], tol)
+        q3, in3 = wrap_into_limits(q3, lo[3], hi[3], tol)
+        q4, in4 = wrap_into_limits(q4, lo[4], hi[4], tol)
+        p = _fk(ch, q0, q1, q2, q3, q4)
+        dx, dy, dz = p[3] - t[3], p[7] - t[7], p[11] - t[11]
+        err = math.sqrt(dx * dx + dy * dy + dz * dz)
+        angle = _rotation_angle(p, t)
+        good = (err <= VECTOR_EXACT) & (angle <= VECTOR_EXACT)
+        final = max(err, angle)
+        stalled = (final >= STALLED * c[_C_PREV * _CW + i]) & (c[_C_FOLD * _CW + i] == 0.0)
+        far = (final > NOT_A_BRANCH) & stalled
+        _put_angles(c, i, q0, q1, q2, q3, q4)
+        c[_C_TAKE * _CW + i] = 1.0 if good else 0.0
+        c[_C_FALL * _CW + i] = (
+            1.0 if (c[_C_FALL * _CW + i] != 0.0) | ((not good) & (not far)) else 0.0
+        )
+        c[_C_IN * _CW + i] = 1.0 if in0 & in1 & in2 & in3 & in4 else 0.0
+        c[_C_PERR * _CW + i] = err
+        c[_C_OERR * _CW + i] = angle
+
+
+@numba.njit(cache=True, nogil=True)
+def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
+    """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
+    of M'_1 .. M'_5, M'_tool (row-major; placements (6, 4, 4), axes (5, 3)).
+
+    With A_i a rotation taking z to the joint axis u_i, R(u_i, q) = A_i R(z, q) A_i^T, so
+    T(q) = M'_1 R(z, q_1) M'_2 ... R(z, q_5) M'_tool with M'_1 = M_1 A_1, M'_i = A_{i-1}^T M_i A_i
+    and M'_tool = A_5^T M_tool: the same poses, and each joint rotation mixes two columns only.
+    """
+    frames = np.zeros((6, 3, 3))  # A_i (columns x', y', u_i); frames[5]: identity for the tool
+    for k in range(5):
+        u = axes[k]
+        a = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+        x = a - (a @ u) * u
+        x /= math.sqrt(x @ x)
+        y = np.cross(u, x)
+        frames[k, :, 0], frames[k, :, 1], frames[k, :, 2] = x, y, u
+    frames[5] = np.eye(3)
+    flat = np.empty(_N_CHAIN)
+    for k in range(6):
+        before = np.eye(3) if k == 0 else frames[k - 1].T.copy()
+        rotation = before @ np.ascontiguousarray(placements[k, :3, :3]) @ frames[k]
+        translation = before @ np.ascontiguousarray(placements[k, :3, 3])
+        for r in range(3):
+            for col in range(3):
+                flat[12 * k + 4 * r + col] = rotation[r, col]
+            flat[12 * k + 4 * r + 3] = translation[r]
+    chain: Floats = to_fixed_tuple(flat, _N_CHAIN)  # type: ignore[call-arg]
+    return chain
+
+
+@numba.njit(cache=True, nogil=True)
+def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    targets: np.ndarray,
+    reference: np.ndarray,
+    q_out: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+    solved: np.ndarray,
+) -> int:
+    """``pose_kernel`` (same arguments and outputs), by blocks of BLOCK vectorised poses with
+    the scalar ``solve_target`` for the poses that need it and the scalar polish for the
+    candidates that need it. Returns how many poses needed either.
+
+    targets: (N, 4, 4) rigid poses; reference (N, 5) or (1, 5) [rad]; outputs (N, B, ...), every
+    slot written; solved (N,): an exact branch was found.
+    """
+    nb = q_out.shape[1]
+    per_side = nb // 2
+    ch = _chain_tuple(placements, axes)
+    pr: Floats = to_fixed_tuple(prm, _N_PRM)  # type: ignore[call-arg]
+    exact = prm[F.EXACT] != 0.0
+    lower, upper, tol = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5], prm[F.LIMIT_TOL]
+    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
+    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
+    shape = (math.hypot(l20, l21), math.hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30))
+    s_flat, c_flat = np.empty(_ROWS * BLOCK), np.empty(_C_ROWS * _CW)
+    s, c = s_flat.reshape((_ROWS, BLOCK)), c_flat.reshape((_C_ROWS, _CW))
+    first = np.empty(BLOCK + 1, dtype=np.int64)  # the candidates of pose i: first[i]..first[i+1]
+    slot_of = np.empty(4 * BLOCK, dtype=np.int64)
+    out = np.empty((nb, SLOT_COLUMNS))
+    g, pose, work = np.empty((3, 4)), np.empty((4, 4)), np.empty((4, 4))
+    qs, jac, origins = np.empty(5), np.empty((6, 5)), np.empty((5, 6))
+    normal, vectors = np.empty((7, 5)), np.empty((3, 6))
+    taken = np.empty((4, 5))
+    fallbacks = 0
+    for start in range(0, targets.shape[0], BLOCK):
+        m = min(BLOCK, targets.shape[0] - start)
+        for i in range(m):
+            for r in range(3):
+                for col in range(4):
+                    s[4 * r + col, i] = targets[start + i, r, col]
+        _closed_forms(m, pr, shape, s_flat)
+        # the candidates of the poses that need no fallback, in the scalar solver's order
+        mc = 0
+        for i in range(m):
+            first[i] = mc
+            fall = False
+            for flip in range(2):
+                fall = fall or s[_FLIP0 + flip * _PER_FLIP + _F_FALL, i] != 0.0
+            s[_POSE_FALL, i] = 1.0 if fall else 0.0
+            if fall:
+                continue
+            for flip in range(2):
+                base = _FLIP0 + flip * _PER_FLIP
+                if s[base + _F_CAND, i] == 0.0:
+                    continue
+                for elbow in range(2):
+                    for k in range(12):
+                        c[k, mc] = s[k, i]
+                    c[_C_Q, mc] = s[base + _F_Q1, i]
+                    for k in range(3):
+                        c[_C_Q + 1 + k, mc] = s[base + (_F_DOWN if elbow else _F_UP) + k, i]
+                    c[_C_Q + 4, mc] = s[base + _F_Q5, i]
+                    for k in range(5):
+                        c[_C_START + k, mc] = c[_C_Q + k, mc]
+                    c[_C_FOLD, mc] = s[base + _F_FOLD, i]
+                    c[_C_FALL, mc] = 0.0
+                    c[_C_PREV, mc] = 0.0
+                    side = int(s[base + _F_SIDE, i])
+                    slot_of[mc] = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
+                    mc += 1
+        first[m] = mc
+        if not exact:
+            _polish_all(mc, ch, c_flat)
+        _settle_all(mc, pr, ch, c_flat)
+        stop = start + m  # every slot empty, then the branches written
+        q_out[start:stop] = np.nan
+        valid[start:stop] = False
+        within[start:stop] = False
+        position_error[start:stop] = np.nan
+        orientation_error[start:stop] = np.nan
+        for i in range(m):
+            n = start + i
+            if s[_POSE_FALL, i] != 0.0:
+                fallbacks += 1
+                ref = reference[n if reference.shape[0] > 1 else 0]
+                solved[n] = solve_target(
+                    prm, placements, axes, targets[n], ref, out,
+                    g, pose, work, qs, jac, origins, normal, vectors,
+                )  # fmt: skip
+                for b in range(nb):
+                    for j in range(5):
+                        q_out[n, b, j] = out[b, j]
+                    valid[n, b] = out[b, VALID] != 0.0
+                    within[n, b] = out[b, WITHIN] != 0.0
+                    position_error[n, b] = out[b, POSITION_ERROR]
+                    orientation_error[n, b] = out[b, ORIENTATION_ERROR]
+                continue
+            count = 0
+            scalar = False
+            for k in range(first[i], first[i + 1]):
+                b = slot_of[k]
+                if valid[n, b]:
+                    continue
+                if c[_C_FALL, k] != 0.0:  # the scalar solver's polish of this candidate
+                    scalar = True
+                    for j in range(5):
+                        qs[j] = c[_C_START + j, k]
+                    current = False
+                    if not exact:
+                        current = polish_pose(
+                            placements, axes, targets[n], qs, pose, work, jac, origins, normal,
+                            vectors,
+                        )  # fmt: skip
+                    inside, err = settle(
+                        placements, axes, lower, upper, tol, targets[n], qs, pose, work, current
+                    )
+                    angle = rotation_angle(targets[n], pose)
+                    if not (err <= POSE_EXACT and angle <= POSE_EXACT):
+                        continue
+                else:
+                    if c[_C_TAKE, k] == 0.0:
+                        continue
+                    for j in range(5):
+                        qs[j] = c[_C_Q + j, k]
+                    inside, err, angle = c[_C_IN, k] != 0.0, c[_C_PERR, k], c[_C_OERR, k]
+                if is_duplicate(taken, _ALL_TAKEN, count, qs, DUPLICATE_TOLERANCE):
+                    continue
+                for j in range(5):
+                    q_out[n, b, j] = qs[j]
+                    taken[count, j] = qs[j]
+                count += 1
+                valid[n, b] = True
+                within[n, b] = inside
+                position_error[n, b] = err
+                orientation_error[n, b] = angle
+            solved[n] = count > 0
+            fallbacks += 1 if scalar else 0
+    return fallbacks
+
+
+@numba.njit(cache=True, nogil=True)
+def smallest_errors(errors: np.ndarray) -> np.ndarray:
+    """The smallest error of each target over its branch slots: errors (N, B) -> (N,), the
+    empty slots' NaN skipped (NaN where every slot is empty); ``np.fmin.reduce(errors, axis=1)``
+    without numpy's per-row cost."""
+    out = np.empty(errors.shape[0])
+    for n in range(errors.shape[0]):
+        best = np.nan
+        for b in range(errors.shape[1]):
+            e = errors[n, b]
+            best = e if (e < best) | math.isnan(best) else best
+        out[n] = best
+    return out

@@ -1,0 +1,149 @@
+"""The vectorised full-pose kernel (``pose_block``) against the scalar one (``pose_kernel``).
+
+Both must give the same slots: the same validity, the same within-limits flags, the same
+"solved" verdict, angles equal to 1e-9 rad (1e-6 next to a double root) and errors no larger
+on every target: random poses,
+poses next to the yaw axis and next to a fold of the elbow, poses out of reach, approaches along
+the yaw axis, and random family URDFs (exact, and only close to the family). The vector path must
+also carry the load: few poses may fall back to the scalar solver.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from lynxplan.robots import Robot, load_robot
+from lynxplan.robots.ik import pose_kernel
+from lynxplan.robots.ik.pose_block import pose_block_kernel, smallest_errors
+from lynxplan.robots.results import BranchSlots
+from tests.robots.test_pose_kernel import _near_axis_poses
+from tests.robots.urdf_factory import write_random_family_urdfs
+
+
+def _both(robot: Robot, poses: np.ndarray, reference: np.ndarray) -> tuple[tuple, tuple, int]:  # type: ignore[type-arg]
+    family, chain = robot.family, robot.chain
+    assert family is not None
+    slots = 4 if family.tool_on_roll_axis else 24
+    results = []
+    fallbacks = 0
+    for kernel in (pose_kernel.pose_kernel, pose_block_kernel):
+        out = BranchSlots.empty(len(poses), slots)
+        solved = np.empty(len(poses), dtype=np.bool_)
+        count = kernel(family.packed, chain.placements, chain.axes, poses, reference, *out, solved)
+        fallbacks = count if count is not None else fallbacks
+        results.append((*out, solved))
+    return results[0], results[1], fallbacks
+
+
+def _assert_same(scalar: tuple, block: tuple) -> None:  # type: ignore[type-arg]
+    q_s, valid_s, within_s, perr_s, oerr_s, solved_s = scalar
+    q_b, valid_b, within_b, perr_b, oerr_b, solved_b = block
+    assert np.array_equal(solved_s, solved_b)
+    assert np.array_equal(valid_s, valid_b)
+    assert np.array_equal(within_s, within_b)
+    # equal angles; next to a double root (a fold of the elbow) Newton stops at ~1e-11 and the
+    # angles along the fold are only fixed to ~ sqrt(error): there 1e-6 rad
+    loose = np.maximum(perr_s, perr_b) > 1e-13
+    gap = np.abs(q_s - q_b).max(axis=-1)
+    assert np.all(gap[valid_s & ~loose] <= 1e-9)
+    assert np.all(gap[valid_s & loose] <= 1e-6)
+    assert np.all(np.isnan(q_b[~valid_b]))
+    # no worse than the scalar solver's (whose polish may stop above 1e-12 next to a fold)
+    assert np.all(perr_b[valid_b] <= np.maximum(perr_s[valid_b], 1e-14) + 1e-12)
+    assert np.all(oerr_b[valid_b] <= np.maximum(oerr_s[valid_b], 1e-14) + 1e-12)
+
+
+def _mixed_poses(robot: Robot, seed: int) -> np.ndarray:
+    rng = np.random.default_rng(seed)
+    q = robot.random_configurations(2000, seed=seed)
+    fold = q[:200].copy()  # elbows next to their folds (built-in angle of the SO-101: -1.28849)
+    fold[:, 2] = -1.28849203 + rng.normal(0.0, 1e-3, 200)
+    poses = robot.fk(np.concatenate((q, fold)))
+    far = poses[:100].copy()
+    far[:, :3, 3] *= 3.0  # out of reach
+    vertical = robot.fk(q[:50])  # the approach along the yaw axis: the yaw left to the position
+    assert robot.family is not None
+    k = np.array(robot.family.yaw_axis)
+    for pose in vertical:
+        a = pose[:3, :3] @ np.array(robot.family.approach_in_tool)
+        axis = np.cross(a, -k)
+        angle = np.arctan2(np.linalg.norm(axis), a @ -k)
+        if np.linalg.norm(axis) > 1e-12:
+            from scipy.spatial.transform import Rotation
+
+            turn = Rotation.from_rotvec(axis / np.linalg.norm(axis) * angle).as_matrix()
+            pose[:3, :3] = turn @ pose[:3, :3]
+    near = _near_axis_poses(robot, 200, seed + 1)
+    return np.ascontiguousarray(np.concatenate((poses, far, vertical, near)))
+
+
+@pytest.mark.parametrize("name", ["so101", "so100"])
+def test_block_kernel_equals_scalar_kernel(name: str) -> None:
+    robot = load_robot(name)
+    poses = _mixed_poses(robot, seed=21)
+    references = [robot._default_reference, robot.random_configurations(len(poses), seed=4)]
+    for reference in references:
+        scalar, block, _ = _both(robot, poses, np.ascontiguousarray(reference))
+        _assert_same(scalar, block)
+
+
+def _tilted(path: Path) -> Path:
+    """The URDF with joint 3's axis tilted by 4e-6 rad, as real URDFs' rounded angles tilt them
+    (the SO-101: 3.7e-6 rad): a model only close to the family, whose branches are polished."""
+    text = path.read_text()
+    start = text.index('<joint name="j3"')
+    at = text.index('rpy="', start) + len('rpy="')
+    roll_end = text.index(" ", at)
+    tilted = path.with_name("tilted_" + path.name)
+    tilted.write_text(text[:at] + repr(float(text[at:roll_end]) + 4e-6) + text[roll_end:])
+    return tilted
+
+
+def test_block_kernel_equals_scalar_kernel_on_random_family_urdfs(tmp_path: Path) -> None:
+    """Exact family models (no polish) and the same tilted (polished); tools on and off the
+    roll axis."""
+    for path in write_random_family_urdfs(tmp_path, 6, seed=7):
+        for urdf in (path, _tilted(path)):
+            robot = load_robot(urdf, tool="tool")
+            assert robot.family is not None
+            assert robot.family.exact == (urdf == path)
+            poses = _mixed_poses(robot, seed=5)
+            scalar, block, _ = _both(robot, poses, robot._default_reference)
+            _assert_same(scalar, block)
+
+
+def test_vector_path_carries_the_load() -> None:
+    """On random reachable SO-101 poses at most 3 % fall back to the scalar solver (1.1 % when
+    written): a vector path that stopped taking its candidates would pass the equality tests
+    above while losing its speed."""
+    robot = load_robot("so101")
+    poses = np.ascontiguousarray(robot.fk(robot.random_configurations(5000, seed=8)))
+    _, _, fallbacks = _both(robot, poses, robot._default_reference)
+    assert fallbacks <= 0.03 * len(poses)
+
+
+def test_smallest_errors_skips_empty_slots() -> None:
+    rng = np.random.default_rng(3)
+    errors = rng.uniform(0.0, 1.0, (500, 24))
+    errors[rng.uniform(size=errors.shape) < 0.7] = np.nan
+    errors[7] = np.nan
+    assert np.array_equal(smallest_errors(errors), np.fmin.reduce(errors, axis=1), equal_nan=True)
+
+
+def test_exact_branches_are_within_the_reach_tolerance() -> None:
+    """``solve_family`` returns the pose kernels' batch as it is when every target has exact
+    branches: each reaches its target within REACH_TOLERANCE (so it is reachable, and no
+    branch is dropped)."""
+    from lynxplan.robots.selection import REACH_TOLERANCE
+
+    assert pose_kernel.POSE_EXACT <= REACH_TOLERANCE
+    robot = load_robot("so101")
+    batch = robot.ik_batch(robot.fk(robot.random_configurations(300, seed=9)))
+    assert batch.reachable.all()
+    assert np.all(batch.position_error[batch.valid] <= REACH_TOLERANCE)
+    assert np.array_equal(
+        batch.distance, np.where(batch.valid, batch.position_error, np.inf).min(axis=1)
+    )
