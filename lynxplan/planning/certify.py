@@ -38,12 +38,13 @@ import numpy as np
 from lynxplan.planning.edge_walk import (
     STEP_GROWTH,
     lever_arms,
+    place_lanes,
     pose_pair_at,
     reach_step,
     span_motion,
 )
-from lynxplan.planning.kernel_model import OBSTACLE_SPHERE
-from lynxplan.planning.lanes import all_pair_bounds
+from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE
+from lynxplan.planning.lanes import OUT_ARMS, OUT_S, OUT_SPHERE, all_pair_bounds, pair_along
 from lynxplan.planning.validity import (
     centre_gap,
     joint_poses,
@@ -54,8 +55,9 @@ from lynxplan.planning.validity import (
 
 #: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.
 MIN_STEP = 1e-4
-#: Longest chain of sphere gaps tried on a segment before the exact chain is scheduled.
-SPHERE_STEPS = 24
+#: Sphere gaps evaluated for one pair on a segment (LANES at a time) before the exact chain is
+#: scheduled instead.
+SPHERE_STEPS = 48
 #: Intervals of the uniform grid of sphere gaps tried first, all pairs at once.
 SPHERE_GRID = 8
 #: ... tried only when the tight bounds at both ends exceed this, in [m] (closer pairs need the
@@ -149,9 +151,11 @@ def _end_bounds(
 def _sphere_chain(
     q_a: np.ndarray, q_b: np.ndarray, p: int, gap: float, model: Any, scratch: Any
 ) -> bool:
-    """Whether pair p's sphere gaps alone prove it apart on the whole segment: a chain of at
-    most :data:`SPHERE_STEPS` points whose consecutive gaps exceed the motion bound between
-    them (:func:`lynxplan.planning.validity.span_motion`), one-sided steps where not."""
+    """Whether pair p's sphere gaps alone prove it apart on the whole segment: a chain of
+    points, from at most :data:`SPHERE_STEPS` evaluated (LANES at a time, by
+    :func:`lynxplan.planning.lanes.pair_along`), whose consecutive gaps exceed the motion bound
+    between them (:func:`lynxplan.planning.validity.span_motion`) or that lie within the
+    previous point's one-sided reach (:func:`lynxplan.planning.edge_walk.reach_step`)."""
     arms = scratch[13]
     if gap <= 0.0:
         return False
@@ -159,24 +163,57 @@ def _sphere_chain(
     gap_end = _bound_at(q_a, q_b, 1.0, p, model, scratch, 1, True)
     if gap_end > 0.0 and gap + gap_end > span_motion(p, 1.0, model, scratch):
         return True  # one two-sided interval: the whole segment
-    s = 0.0
-    for _ in range(SPHERE_STEPS):
-        if gap <= 0.0:
-            return False
-        one = reach_step(gap, p, arms[0], model, scratch)
-        if s + one >= 1.0:
-            return True
-        t = min(1.0, s + STEP_GROWTH * one)
-        gap_t = _bound_at(q_a, q_b, t, p, model, scratch, 1, True)
-        if gap_t > 0.0 and gap + gap_t > span_motion(p, t - s, model, scratch):
+    s, trend = 0.0, 0.0
+    out = scratch[17]
+    one = reach_step(gap, p, arms[0], model, scratch)
+    for _ in range(SPHERE_STEPS // LANES):
+        if s + one >= 1.0 or not place_lanes(s, gap, one, trend, out):
+            break
+        pair_along(q_a, q_b, p, model, out)
+        progressed, i = False, 0
+        while i < LANES and s + one < 1.0:
+            best = _farthest_sphere(i, s, gap, one, p, model, scratch)
+            if best < 0:
+                break
+            t, gap_t = out[OUT_S, best], out[OUT_SPHERE, best]
+            trend = (gap_t - gap) / (t - s)
             s, gap = t, gap_t
-        else:
-            s += one
-            gap = _bound_at(q_a, q_b, s, p, model, scratch, 1, True)
-        arms[0, :] = arms[1]
-        if s >= 1.0:
-            return True
-    return False
+            for j in range(arms.shape[1]):
+                arms[0, j] = out[OUT_ARMS + j, best]
+            one = reach_step(gap, p, arms[0], model, scratch)
+            progressed, i = True, best + 1
+        if not progressed:
+            break
+    return s + one >= 1.0  # certified one-sided from the last point to the end
+
+
+@numba.njit(cache=True, inline="always")
+def _farthest_sphere(
+    i: int, s: float, gap: float, one: float, p: int, model: Any, scratch: Any
+) -> int:
+    """The farthest lane k >= i of a vectorised run (scratch[17]) that the sphere gaps certify
+    from s (gap [m], lever arms scratch[13][0]): within the one-sided reach s + one, or by the
+    two-sided test (:func:`span_motion`), with a positive gap; scanning forward until a lane
+    fails after one passed. -1: none."""
+    out, arms = scratch[17], scratch[13]
+    best = -1
+    for k in range(i, LANES):
+        t = out[OUT_S, k]
+        gap_t = out[OUT_SPHERE, k]
+        if t <= s:
+            continue
+        if gap_t <= 0.0:
+            break
+        ok = t <= s + one
+        if not ok:
+            for j in range(arms.shape[1]):
+                arms[1, j] = out[OUT_ARMS + j, k]
+            ok = gap + gap_t > span_motion(p, t - s, model, scratch)
+        if ok:
+            best = k
+        elif best >= 0:
+            break
+    return best
 
 
 @numba.njit(cache=True)

@@ -16,6 +16,14 @@ over it. The pair certified least far advances next; the walk stops where a boun
 real geometry with distance >= ``clearance``: no sampling resolution, nothing skipped between
 samples.
 
+Most pairs are certified before any step, from every pair's bounds at the edge's start, its end
+and (when a quick test of it came first) its midpoint, computed all pairs at once
+(:func:`lynxplan.planning.lanes.all_pair_bounds`), with the static motion bound
+(:func:`_walk_start`).
+A pair that needs steps advances through several points per vectorised call
+(:func:`lynxplan.planning.lanes.pair_along`, :func:`_lane_run`); each accepted point passes the
+same one- or two-sided test as a single step.
+
 Primitives fixed to the base (joint 0) do not move: their obstacle pairs are checked once,
 exactly, by the problem set-up, and left out here.
 """
@@ -286,7 +294,7 @@ def _walk_start(
 
 
 @numba.njit(cache=True, inline="always")
-def _place_lanes(s: float, sigma: float, one: float, trend: float, out: np.ndarray) -> bool:
+def place_lanes(s: float, sigma: float, one: float, trend: float, out: np.ndarray) -> bool:
     """The points of a run (:func:`_lane_run`) from s, slack sigma [m], one-sided step ``one``
     and slack trend [m per unit s] -> out[OUT_S]; False when there is no step to take."""
     if one <= 0.0 or sigma <= 0.0:
@@ -369,7 +377,7 @@ def _lane_run(
     slack, reach, where, arms = scratch[4], scratch[5], scratch[6], scratch[13]
     all_arms, trend, out, counters = scratch[15], scratch[16], scratch[17], scratch[9]
     s, sigma = where[p], slack[p]
-    if not _place_lanes(s, sigma, nearest - s, trend[p], out):
+    if not place_lanes(s, sigma, nearest - s, trend[p], out):
         return 0.0
     pair_along(q_a, q_b, p, model, out)
     counters[1] += LANES

@@ -91,7 +91,7 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         np.empty(nq),
         np.empty((pairs, nq)),
         np.empty(pairs),
-        np.empty((2 + nq, LANES)),
+        np.empty((3 + nq, LANES)),
         np.empty(pairs),
         np.empty(pairs),
     )

@@ -52,9 +52,10 @@ _S = _B + 12
 _T = _S + 1
 _BOUND = _T + 1
 _ROWS = _BOUND + 1
-#: Rows of the output of :func:`pair_along`: 0 the bound [m], 1 the parameter s (input), 2 + j
-#: the lever arm about configuration index j [m].
-OUT_BOUND, OUT_S, OUT_ARMS = 0, 1, 2
+#: Rows of the output of :func:`pair_along`: 0 the bound [m], 1 the parameter s (input), 2 the
+#: bounding-sphere gap of the exact verification [m], 3 + j the lever arm about configuration
+#: index j [m].
+OUT_BOUND, OUT_S, OUT_SPHERE, OUT_ARMS = 0, 1, 2, 3
 
 
 def lanes_supported(model: tuple[np.ndarray, ...]) -> bool:
@@ -292,7 +293,8 @@ def _arm_rows(w: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
 def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
     """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
     [rad]: out[OUT_BOUND] its distance lower bound [m], out[OUT_ARMS + j] its lever arm about
-    configuration index j [m]; out: (2 + nq, LANES).
+    configuration index j [m], out[OUT_SPHERE] its bounding-sphere gap [m]; out: (3 + nq,
+    LANES).
 
     The model must satisfy :func:`lanes_supported`.
     """
@@ -322,7 +324,47 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
         _box_bounds(w, half, a, model[13], b, radius[a] + model[14][b])
     for i in range(LANES):
         out[OUT_BOUND, i] = w[_BOUND, i]
+    _sphere_gap_rows(w, p, model)
+    for i in range(LANES):
+        out[OUT_SPHERE, i] = w[_BOUND, i]
     _arm_rows(w, p, model, out)
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
+    """The bounding-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`: robot
+    primitives by their circumscribed spheres, a box obstacle by its exact point distance, a
+    sphere obstacle exactly) from rows _A (and _B), every lane -> row _BOUND, in [m]."""
+    pairs, radius = model[8], model[7]
+    a, b = pairs[p, 0], pairs[p, 1]
+    ra = radius[a]
+    if pairs[p, 2] == 1:
+        rb = radius[b]
+        for i in range(LANES):
+            d0 = w[_B + 9, i] - w[_A + 9, i]
+            d1 = w[_B + 10, i] - w[_A + 10, i]
+            d2 = w[_B + 11, i] - w[_A + 11, i]
+            w[_BOUND, i] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2) - ra - rb
+        return
+    if model[10][b] == OBSTACLE_SPHERE:  # (rows _B are not filled for a sphere obstacle)
+        c0, c1, c2 = model[12][b, 0, 3], model[12][b, 1, 3], model[12][b, 2, 3]
+        rb = model[13][b, 0]
+        for i in range(LANES):
+            d0, d1, d2 = c0 - w[_A + 9, i], c1 - w[_A + 10, i], c2 - w[_A + 11, i]
+            w[_BOUND, i] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2) - ra - rb
+        return
+    pose, half = model[12], model[13]
+    c0, c1, c2 = pose[b, 0, 3], pose[b, 1, 3], pose[b, 2, 3]
+    h0, h1, h2 = half[b, 0], half[b, 1], half[b, 2]
+    x0, x1, x2 = pose[b, 0, 0], pose[b, 1, 0], pose[b, 2, 0]
+    y0, y1, y2 = pose[b, 0, 1], pose[b, 1, 1], pose[b, 2, 1]
+    z0, z1, z2 = pose[b, 0, 2], pose[b, 1, 2], pose[b, 2, 2]
+    for i in range(LANES):
+        d0, d1, d2 = w[_A + 9, i] - c0, w[_A + 10, i] - c1, w[_A + 11, i] - c2
+        e0 = max(abs(x0 * d0 + x1 * d1 + x2 * d2) - h0, 0.0)
+        e1 = max(abs(y0 * d0 + y1 * d1 + y2 * d2) - h1, 0.0)
+        e2 = max(abs(z0 * d0 + z1 * d1 + z2 * d2) - h2, 0.0)
+        w[_BOUND, i] = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) - ra
 
 
 #: Pairs per block of :func:`all_pair_bounds` (a constant width: no run-time aliasing checks).

@@ -10,8 +10,9 @@ gives one root per collision-free IK branch). Each iteration, in the compiled ke
    conservative advancement (:func:`lynxplan.planning.edge_walk.edge_fraction`), after a
    quick test of its midpoint (a blocked extension is usually blocked there);
 3. *connect* the other tree to the new node: the straight edge from its nearest node is walked
-   as far as it is certified; nodes are added every ``step`` along it; reaching the new node
-   joins the trees;
+   as far as it is certified; nodes are added every ``step`` along it (the points there are
+   tested first, and the walk covers the edge only up to the last clear one); reaching the new
+   node joins the trees;
 4. swap the trees.
 
 A node's pair slacks (bound minus clearance, the start of every edge walk from it) are computed

@@ -9,7 +9,7 @@ What it tests
     parent/child pair of joints, the URDF adjacency) — the checker computes a *lower bound* of the
     Euclidean distance:
 
-    - the bounding-sphere gap ``|c_a - c_b| - r_a - r_b``, and, when that is small,
+    - the bounding-sphere gap ``|c_a - c_b| - r_a - r_b``, and
     - the separating-axis gap: the largest separation of the two boxes' projections over the 15
       axes of the separating axis theorem (box faces and edge cross products). Projection on a
       unit vector is 1-Lipschitz, so every projected gap is a lower bound of the distance; it is
@@ -18,7 +18,10 @@ What it tests
 
     A sphere obstacle is bounded exactly (closest point of the box minus the radius); a cylinder
     obstacle is replaced by its bounding box. A state is valid when every pair's bound exceeds
-    the required ``clearance`` (so the exact distance does too).
+    the required ``clearance`` (so the exact distance does too). The bounds of all pairs of a
+    state come from one vectorised kernel over all 15 axes
+    (:func:`lynxplan.planning.lanes.all_pair_bounds`); the scalar :func:`pair_bound` (one pair,
+    the edge axes only when the face axes leave a small gap) serves single pairs.
 
 Edges
     Conservative advancement along an edge: :mod:`lynxplan.planning.edge_walk`.

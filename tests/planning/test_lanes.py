@@ -8,8 +8,16 @@ from test_validity import BOUND_TOLERANCE, OBSTACLES
 
 from lynxplan.arm import Arm
 from lynxplan.collision import CollisionWorld
+from lynxplan.planning.certify import sphere_gap
 from lynxplan.planning.kernel_model import LANES
-from lynxplan.planning.lanes import OUT_ARMS, OUT_BOUND, OUT_S, all_pair_bounds, pair_along
+from lynxplan.planning.lanes import (
+    OUT_ARMS,
+    OUT_BOUND,
+    OUT_S,
+    OUT_SPHERE,
+    all_pair_bounds,
+    pair_along,
+)
 from lynxplan.planning.validity import ValidityChecker, pair_bound, primitive_poses
 from lynxplan.planning.verify import ExactVerifier
 
@@ -64,7 +72,7 @@ def test_pair_along_matches_single_steps_and_stays_below_coal(
     rng = np.random.default_rng(4)
     pairs = len(checker.pair_names)
     nq = checker.nq
-    out = np.empty((2 + nq, LANES))
+    out = np.empty((3 + nq, LANES))
     full = np.empty(pairs)
     near = 0
     for k in range(SAMPLES):
@@ -78,13 +86,16 @@ def test_pair_along_matches_single_steps_and_stays_below_coal(
             pose_pair_at(q_a, q_b, s, p, model, scratch, 1)
             np.testing.assert_allclose(out[OUT_ARMS:, i], scratch[13][1], atol=ROUNDING)
             assert out[OUT_BOUND, i] >= pair_bound(p, model, scratch) - ROUNDING
+            assert abs(out[OUT_SPHERE, i] - sphere_gap(p, model, scratch)) <= ROUNDING
             primitive_poses(q_a + s * (q_b - q_a), model, scratch)
             all_pair_bounds(model, scratch[3], full)
             assert abs(out[OUT_BOUND, i] - full[p]) <= ROUNDING
             exact = _exact(verifier, checker, scratch[3])[p]
             if exact > 0:
                 assert out[OUT_BOUND, i] <= exact + BOUND_TOLERANCE
+                assert out[OUT_SPHERE, i] <= exact + BOUND_TOLERANCE
                 near += exact < 0.01
             else:
                 assert out[OUT_BOUND, i] <= 0.0
+                assert out[OUT_SPHERE, i] <= 0.0
     assert near > 5
