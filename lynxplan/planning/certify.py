@@ -44,7 +44,14 @@ from lynxplan.planning.edge_walk import (
     span_motion,
 )
 from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE
-from lynxplan.planning.lanes import OUT_ARMS, OUT_S, OUT_SPHERE, all_pair_bounds, pair_along
+from lynxplan.planning.lanes import (
+    MAX_JOINTS,
+    OUT_ARMS,
+    OUT_S,
+    OUT_SPHERE,
+    all_pair_bounds,
+    pair_along,
+)
 from lynxplan.planning.validity import (
     centre_gap,
     joint_poses,
@@ -163,6 +170,8 @@ def _sphere_chain(
     gap_end = _bound_at(q_a, q_b, 1.0, p, model, scratch, 1, True)
     if gap_end > 0.0 and gap + gap_end > span_motion(p, 1.0, model, scratch):
         return True  # one two-sided interval: the whole segment
+    if model[0].shape[0] > MAX_JOINTS:  # too many joints for the lanes: the exact chain
+        return False
     s, trend = 0.0, 0.0
     out = scratch[17]
     one = reach_step(gap, p, arms[0], model, scratch)
