@@ -58,7 +58,7 @@ from lynxplan.robots.ik.pose_kernel import (
     solve_target,
 )
 
-_FAST = {"contract", "arcp"}
+_FAST = {"contract", "arcp"}  # fused multiply-adds, reciprocals: as in ``arm.ik_kernel``
 #: Floats in registers: a pose (12, row-major 3 x 4), a Jacobian column (6), the parameters.
 Floats = tuple[float, ...]
 #: One flip's branches: q1, (q2, q3, q4) elbow up, (q2, q3, q4) elbow down, q5, candidate,
@@ -71,18 +71,19 @@ atan2 = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.atan2.py_func)
 #: Poses per block (a constant width: the scratch rows never alias, see ``arm.ik_kernel``).
 BLOCK = 32
 #: A candidate is taken by the vector path when its final position [m] and orientation [rad]
-#: errors are both below this; otherwise its pose goes to the scalar solver.
+#: errors are both below this; otherwise it is rejected (below) or finished by the scalar polish.
 VECTOR_EXACT = 1e-14
 #: A candidate whose final position [m] or orientation [rad] error is above NOT_A_BRANCH and has
 #: stopped falling (at least STALLED times the error before the last chord step) is not an exact
 #: branch: the orientation is out of reach on that flip, and the steps end at the residual of the
 #: nearest orientation (~1e-4), as the scalar polish does, which rejects it too. A candidate
 #: still falling there, or next to a fold of the elbow (where the chord steps stall before Newton's
-#: would: the roots are close), falls back.
+#: would: the roots are close), is finished by the scalar polish.
 NOT_A_BRANCH, STALLED = 1e-6, 0.5
 #: Next to a fold: |cos| of the elbow angle within this of 1 (an elbow ~0.045 rad from straight).
 FOLD_BAND = 1e-3
-#: The polish's normal matrix this ill-conditioned (smallest over largest LDL^T pivot) falls back.
+#: A candidate whose normal matrix is this ill-conditioned (smallest over largest LDL^T pivot) is
+#: finished by the scalar polish.
 ILL_CONDITIONED = 1e-8
 _N_CHAIN = 6 * 12  # the 3 x 4 blocks of M'_1..M'_5, M'_tool (see ``_chain_tuple``)
 _N_PRM = F.N_PARAMS
