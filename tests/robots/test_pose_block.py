@@ -147,3 +147,27 @@ def test_exact_branches_are_within_the_reach_tolerance() -> None:
     assert np.array_equal(
         batch.distance, np.where(batch.valid, batch.position_error, np.inf).min(axis=1)
     )
+
+
+def test_chain_turned_about_z_gives_the_same_poses() -> None:
+    """The kernel's chain (each joint turned about its own z axis) against ``chain_fk`` on
+    random placements and random unit axes (not only the URDFs' x/y/z)."""
+    from scipy.spatial.transform import Rotation
+
+    from lynxplan.robots.chain import chain_fk
+    from lynxplan.robots.ik.pose_block import _chain_tuple, _fk
+
+    rng = np.random.default_rng(12)
+    for _ in range(20):
+        placements = np.tile(np.eye(4), (6, 1, 1))
+        placements[:, :3, :3] = Rotation.random(6, random_state=rng).as_matrix()
+        placements[:, :3, 3] = rng.uniform(-0.2, 0.2, (6, 3))
+        axes = rng.normal(size=(5, 3))
+        axes /= np.linalg.norm(axes, axis=1)[:, None]
+        axes[rng.uniform(size=5) < 0.4] = [0.0, 0.0, -1.0]
+        chain = _chain_tuple(placements, axes)
+        for q in rng.uniform(-np.pi, np.pi, (10, 5)):
+            expected = np.empty((4, 4))
+            chain_fk(placements, axes, q, expected, np.empty((4, 4)))
+            got = np.array(_fk(chain, *q)).reshape(3, 4)
+            assert np.abs(got - expected[:3]).max() < 1e-14

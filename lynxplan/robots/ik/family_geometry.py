@@ -96,18 +96,24 @@ def approach_in_plane(
 
 @numba.njit(cache=True, nogil=True, inline="always")
 def best_roll_terms(
-    prm: np.ndarray, g: np.ndarray, cy: float, sy: float, cp: float, sp: float
+    prm: np.ndarray | tuple[float, ...],
+    g: tuple[float, ...],
+    cy: float,
+    sy: float,
+    cp: float,
+    sp: float,
 ) -> tuple[float, float]:
     """(sine, cosine) terms of the best roll for M = Q^T G, Q = R(k, -yaw) R(p, -pitch sum)
-    given by the cosines and sines (cy, sy) of -yaw and (cp, sp) of -pitch sum."""
+    given by the cosines and sines (cy, sy) of -yaw and (cp, sp) of -pitch sum; g: the 9
+    entries of G's rotation block, row-major; prm: the packed parameters (array or tuple)."""
     k0, k1, k2 = prm[F.K], prm[F.K + 1], prm[F.K + 2]
     p0, p1, p2 = prm[F.P], prm[F.P + 1], prm[F.P + 2]
     r0, r1, r2 = prm[F.R], prm[F.R + 1], prm[F.R + 2]
-    x0, x1, x2 = rotate(k0, k1, k2, cy, sy, g[0, 0], g[1, 0], g[2, 0])
+    x0, x1, x2 = rotate(k0, k1, k2, cy, sy, g[0], g[3], g[6])
     m00, m10, m20 = rotate(p0, p1, p2, cp, sp, x0, x1, x2)
-    x0, x1, x2 = rotate(k0, k1, k2, cy, sy, g[0, 1], g[1, 1], g[2, 1])
+    x0, x1, x2 = rotate(k0, k1, k2, cy, sy, g[1], g[4], g[7])
     m01, m11, m21 = rotate(p0, p1, p2, cp, sp, x0, x1, x2)
-    x0, x1, x2 = rotate(k0, k1, k2, cy, sy, g[0, 2], g[1, 2], g[2, 2])
+    x0, x1, x2 = rotate(k0, k1, k2, cy, sy, g[2], g[5], g[8])
     m02, m12, m22 = rotate(p0, p1, p2, cp, sp, x0, x1, x2)
     sine = r0 * (m21 - m12) + r1 * (m02 - m20) + r2 * (m10 - m01)
     rmr = (
@@ -121,8 +127,9 @@ def best_roll_terms(
 @numba.njit(cache=True, nogil=True)
 def best_roll(prm: np.ndarray, g: np.ndarray, phi: float, big_phi: float) -> float:
     """Canonical roll theta nearest the target: argmax tr(R(r, theta)^T M), M = Q^T G."""
+    g9 = (g[0, 0], g[0, 1], g[0, 2], g[1, 0], g[1, 1], g[1, 2], g[2, 0], g[2, 1], g[2, 2])
     sine, cosine = best_roll_terms(
-        prm, g, math.cos(-phi), math.sin(-phi), math.cos(-big_phi), math.sin(-big_phi)
+        prm, g9, math.cos(-phi), math.sin(-phi), math.cos(-big_phi), math.sin(-big_phi)
     )
     return math.atan2(sine, cosine)
 

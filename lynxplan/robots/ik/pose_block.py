@@ -40,6 +40,7 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 from lynxplan import _fastmath
 from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
 from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
 from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
 from lynxplan.robots.ik.pose_kernel import (
@@ -57,7 +58,7 @@ from lynxplan.robots.ik.pose_kernel import (
     solve_target,
 )
 
-_FAST = {"contract", "arcp"}
+_FAST = {"contract", "arcp"}  # fused multiply-adds, reciprocals: as in ``arm.ik_kernel``
 #: Floats in registers: a pose (12, row-major 3 x 4), a Jacobian column (6), the parameters.
 Floats = tuple[float, ...]
 #: One flip's branches: q1, (q2, q3, q4) elbow up, (q2, q3, q4) elbow down, q5, candidate,
@@ -70,20 +71,20 @@ atan2 = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.atan2.py_func)
 #: Poses per block (a constant width: the scratch rows never alias, see ``arm.ik_kernel``).
 BLOCK = 32
 #: A candidate is taken by the vector path when its final position [m] and orientation [rad]
-#: errors are both below this; otherwise its pose goes to the scalar solver.
+#: errors are both below this; otherwise it is rejected (below) or finished by the scalar polish.
 VECTOR_EXACT = 1e-14
 #: A candidate whose final position [m] or orientation [rad] error is above NOT_A_BRANCH and has
 #: stopped falling (at least STALLED times the error before the last chord step) is not an exact
 #: branch: the orientation is out of reach on that flip, and the steps end at the residual of the
 #: nearest orientation (~1e-4), as the scalar polish does, which rejects it too. A candidate
 #: still falling there, or next to a fold of the elbow (where the chord steps stall before Newton's
-#: would: the roots are close), falls back.
+#: would: the roots are close), is finished by the scalar polish.
 NOT_A_BRANCH, STALLED = 1e-6, 0.5
 #: Next to a fold: |cos| of the elbow angle within this of 1 (an elbow ~0.045 rad from straight).
 FOLD_BAND = 1e-3
-#: The polish's normal matrix this ill-conditioned (smallest over largest LDL^T pivot) falls back.
+#: A candidate whose normal matrix is this ill-conditioned (smallest over largest LDL^T pivot) is
+#: finished by the scalar polish.
 ILL_CONDITIONED = 1e-8
-_TWO_PI = 2.0 * math.pi
 _N_CHAIN = 6 * 12  # the 3 x 4 blocks of M'_1..M'_5, M'_tool (see ``_chain_tuple``)
 _N_PRM = F.N_PARAMS
 
@@ -111,24 +112,6 @@ def _acos(x: float) -> float:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _wrap(x: float) -> float:
-    return x - _TWO_PI * math.floor((x + math.pi) / _TWO_PI)
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _rot(
-    u0: float, u1: float, u2: float, c: float, s: float, v0: float, v1: float, v2: float
-) -> tuple[float, float, float]:
-    """Rodrigues: v rotated by the angle with cosine c and sine s about the unit axis u."""
-    d = (u0 * v0 + u1 * v1 + u2 * v2) * (1.0 - c)
-    return (
-        v0 * c + (u1 * v2 - u2 * v1) * s + u0 * d,
-        v1 * c + (u2 * v0 - u0 * v2) * s + u1 * d,
-        v2 * c + (u0 * v1 - u1 * v0) * s + u2 * d,
-    )
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _pitch_sum(pr: Floats, a0: float, a1: float, a2: float, phi: float) -> tuple[float, bool]:
     """Canonical pitch sum for yaw phi and approach a, and whether it is degenerate (the
     approach along the pitch axis)."""
@@ -146,22 +129,8 @@ def _best_roll(pr: Floats, g: Floats, phi: float, big_phi: float) -> float:
     G = Rt Rt0^T, row-major."""
     sy, cy = sincos(-phi)
     sp, cp = sincos(-big_phi)
-    k0, k1, k2 = pr[F.K], pr[F.K + 1], pr[F.K + 2]
-    p0, p1, p2 = pr[F.P], pr[F.P + 1], pr[F.P + 2]
-    r0, r1, r2 = pr[F.R], pr[F.R + 1], pr[F.R + 2]
-    x0, x1, x2 = _rot(k0, k1, k2, cy, sy, g[0], g[3], g[6])
-    m00, m10, m20 = _rot(p0, p1, p2, cp, sp, x0, x1, x2)
-    x0, x1, x2 = _rot(k0, k1, k2, cy, sy, g[1], g[4], g[7])
-    m01, m11, m21 = _rot(p0, p1, p2, cp, sp, x0, x1, x2)
-    x0, x1, x2 = _rot(k0, k1, k2, cy, sy, g[2], g[5], g[8])
-    m02, m12, m22 = _rot(p0, p1, p2, cp, sp, x0, x1, x2)
-    sine = r0 * (m21 - m12) + r1 * (m02 - m20) + r2 * (m10 - m01)
-    rmr = (
-        r0 * (m00 * r0 + m01 * r1 + m02 * r2)
-        + r1 * (m10 * r0 + m11 * r1 + m12 * r2)
-        + r2 * (m20 * r0 + m21 * r1 + m22 * r2)
-    )
-    return atan2(sine, m00 + m11 + m22 - rmr)
+    sine, cosine = best_roll_terms(pr, g, cy, sy, cp, sp)
+    return atan2(sine, cosine)
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -218,8 +187,8 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     yaw0, lat_miss, on_axis = _yaw(pr, dp, dh, rho, theta, 0)
     yaw1, _, _ = _yaw(pr, dp, dh, rho, theta, 1)
     lat_ok = lat_miss <= REACH_MISS
-    ok0 = lat_ok & (abs(_wrap(yaw0 - phi)) <= match)
-    ok1 = lat_ok & (abs(_wrap(yaw1 - phi)) <= match)
+    ok0 = lat_ok & (abs(wrap(yaw0 - phi)) <= match)
+    ok1 = lat_ok & (abs(wrap(yaw1 - phi)) <= match)
     side = 1.0 if ok1 else 0.0
     phi2 = yaw1 if ok1 else yaw0
     big2, flat2 = _pitch_sum(pr, a0, a1, a2, phi2)
@@ -306,22 +275,15 @@ def _axis_of(t: Floats) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _base(ch: Floats) -> Floats:
+    """M'_1, the first joint's placement (12: row-major 3 x 4), where every pose starts."""
+    return ch[0], ch[1], ch[2], ch[3], ch[4], ch[5], ch[6], ch[7], ch[8], ch[9], ch[10], ch[11]
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _fk(ch: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
     """Tool pose (12: row-major 3 x 4) of the chain at q."""
-    t: Floats = (
-        ch[0],
-        ch[1],
-        ch[2],
-        ch[3],
-        ch[4],
-        ch[5],
-        ch[6],
-        ch[7],
-        ch[8],
-        ch[9],
-        ch[10],
-        ch[11],
-    )
+    t = _base(ch)
     t = _joint(ch, 0, t, q0)
     t = _joint(ch, 1, t, q1)
     t = _joint(ch, 2, t, q2)
@@ -451,20 +413,7 @@ def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q
     """One Gauss-Newton step and two chord steps on the exact chain from q: the final q,
     the smallest over the largest LDL^T pivot of J^T J (its conditioning), and the largest
     component of the pose error before the last chord step."""
-    p: Floats = (
-        ch[0],
-        ch[1],
-        ch[2],
-        ch[3],
-        ch[4],
-        ch[5],
-        ch[6],
-        ch[7],
-        ch[8],
-        ch[9],
-        ch[10],
-        ch[11],
-    )
+    p = _base(ch)
     o0 = _axis_of(p)
     p = _joint(ch, 0, p, q0)
     o1 = _axis_of(p)
