@@ -9,6 +9,7 @@ from conftest import dense_min_distance
 
 from lynxplan.arm import Arm
 from lynxplan.collision import BoxObstacle, CollisionWorld, SphereObstacle
+from lynxplan.constants import COAL_GJK_TOLERANCE
 from lynxplan.exceptions import PathVerificationError
 from lynxplan.planning.verify import verifier_of, verify_path
 
@@ -93,3 +94,38 @@ def test_a_single_configuration_and_the_verifier_is_kept_per_world(
     exact = world.distances(q)[0].min()
     assert report.min_clearance.clearance == pytest.approx(exact, abs=1e-9)
     assert verifier_of(world) is verifier_of(world)
+
+
+def test_closest_contact_and_sample_clearances_are_the_exact_minimum(
+    arm: Arm, world: CollisionWorld
+) -> None:
+    """The start/goal check's closest contact and the samples' branch and bound on the lower
+    bounds give the smallest distance (and pair) of all pairs, in contact and apart, on the AL5
+    and on the SO-101's meshes."""
+    from lynxplan.planning.verify import closest_contact, sample_clearances
+    from lynxplan.robots import load_robot
+
+    so101 = load_robot("so101")
+    block = BoxObstacle("block", [0.2, 0.0, 0.05], [0.06, 0.06, 0.1])
+    rng = np.random.default_rng(31)
+    for robot, collision_world in (
+        (arm, world),
+        (so101, CollisionWorld(so101, [block], self_collision=True)),
+    ):
+        lower = np.asarray(robot.limits.lower)
+        upper = np.asarray(robot.limits.upper)
+        q = rng.uniform(lower, upper, size=(40, lower.size))
+        every = collision_world.distances(q)
+        assert (every.min(axis=1) < 0).any() and (every.min(axis=1) > 0).any()
+        np.testing.assert_allclose(
+            sample_clearances(collision_world, q), every.min(axis=1), atol=COAL_GJK_TOLERANCE
+        )
+        for n in range(len(q)):
+            distance, link, other = closest_contact(collision_world, q[n])
+            pair = int(np.argmin(every[n]))
+            # coal's GJK/EPA answers depend on its warm start (the previous query): equal to
+            # its tolerance
+            assert distance == pytest.approx(every[n, pair], abs=COAL_GJK_TOLERANCE)
+            names = collision_world.pair_names(pair)
+            if np.sort(every[n])[1] - every[n, pair] > 2 * COAL_GJK_TOLERANCE:  # one nearest
+                assert (link, other) == (names[0], names[2])
