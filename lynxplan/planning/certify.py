@@ -37,6 +37,7 @@ import numpy as np
 
 from lynxplan.planning.edge_walk import (
     STEP_GROWTH,
+    farthest_lane,
     lever_arms,
     place_lanes,
     pose_pair_at,
@@ -181,7 +182,7 @@ def _sphere_chain(
         pair_along(q_a, q_b, p, model, out)
         progressed, i = False, 0
         while i < LANES and s + one < 1.0:
-            best = _farthest_sphere(i, s, gap, one, p, model, scratch)
+            best = farthest_lane(i, s, gap, one, p, model, scratch, OUT_SPHERE, 0.0, 0.0)
             if best < 0:
                 break
             t, gap_t = out[OUT_S, best], out[OUT_SPHERE, best]
@@ -194,35 +195,6 @@ def _sphere_chain(
         if not progressed:
             break
     return s + one >= 1.0  # certified one-sided from the last point to the end
-
-
-@numba.njit(cache=True, inline="always")
-def _farthest_sphere(
-    i: int, s: float, gap: float, one: float, p: int, model: Any, scratch: Any
-) -> int:
-    """The farthest lane k >= i of a vectorised run (scratch[17]) that the sphere gaps certify
-    from s (gap [m], lever arms scratch[13][0]): within the one-sided reach s + one, or by the
-    two-sided test (:func:`span_motion`), with a positive gap; scanning forward until a lane
-    fails after one passed. -1: none."""
-    out, arms = scratch[17], scratch[13]
-    best = -1
-    for k in range(i, LANES):
-        t = out[OUT_S, k]
-        gap_t = out[OUT_SPHERE, k]
-        if t <= s:
-            continue
-        if gap_t <= 0.0:
-            break
-        ok = t <= s + one
-        if not ok:
-            for j in range(arms.shape[1]):
-                arms[1, j] = out[OUT_ARMS + j, k]
-            ok = gap + gap_t > span_motion(p, t - s, model, scratch)
-        if ok:
-            best = k
-        elif best >= 0:
-            break
-    return best
 
 
 @numba.njit(cache=True)

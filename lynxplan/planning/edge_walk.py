@@ -314,34 +314,38 @@ def place_lanes(s: float, sigma: float, one: float, trend: float, out: np.ndarra
 
 
 @numba.njit(cache=True, inline="always")
-def _farthest(
+def farthest_lane(
     i: int,
     s: float,
-    sigma: float,
+    slack: float,
     own: float,
     p: int,
     model: Any,
     scratch: Any,
-    clearance: float,
+    row: int,
+    offset: float,
+    floor: float,
 ) -> int:
-    """The farthest lane k >= i of a run (scratch[17]) certified from s (slack sigma [m], lever
-    arms scratch[13][0], one-sided reach s + own) with slack above STALL_DISTANCE, scanning
-    forward until a lane fails after one passed; -1: none; -2 - k: lane k, the first lane
-    after s, is a wall (slack within STALL_DISTANCE)."""
+    """The farthest lane k >= i of a vectorised run (scratch[17]) certified from s (slack
+    [m], lever arms scratch[13][0], one-sided reach s + own): the lane's slack
+    ``scratch[17][row, k] - offset`` above ``floor``, and k within the reach or passing the
+    two-sided test (:func:`span_motion`); scanning forward until a lane fails after one passed.
+    -1: none; -2 - k: lane k, the first lane after s, has its slack at or below ``floor`` (a
+    wall for the edge walk; the sphere chains stop there too)."""
     out, arms = scratch[17], scratch[13]
     best = -1
     for k in range(i, LANES):
         t = out[OUT_S, k]
-        sigma_t = out[OUT_BOUND, k] - clearance
+        slack_t = out[row, k] - offset
         if t <= s:
             continue
-        if sigma_t <= STALL_DISTANCE:
+        if slack_t <= floor:
             return -2 - k if best < 0 else best
         ok = t <= s + own
         if not ok:
             for j in range(arms.shape[1]):
                 arms[1, j] = out[OUT_ARMS + j, k]
-            ok = sigma + sigma_t > span_motion(p, t - s, model, scratch)
+            ok = slack + slack_t > span_motion(p, t - s, model, scratch)
         if ok:
             best = k
         elif best >= 0:
@@ -386,7 +390,9 @@ def _lane_run(
     accepted, i = 0, 0
     own = reach_step(sigma, p, arms[0], model, scratch)
     while i < LANES:
-        best = _farthest(i, s, sigma, own, p, model, scratch, clearance)
+        best = farthest_lane(
+            i, s, sigma, own, p, model, scratch, OUT_BOUND, clearance, STALL_DISTANCE
+        )
         if best < -1:  # a wall at the first point
             t = float(out[OUT_S, -2 - best])
             if accepted == 0 and t <= nearest:

@@ -53,39 +53,38 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
     slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
     out = BranchSlots.empty(n, slots)
     rest = None
+    exact_everywhere = False
     if robot._arm is not None and target.kind != fk_.MODE_PITCH:
         out.clear()
         rest = ~al5_fill(robot, target, reference, out)
     elif target.kind == fk_.MODE_POSE:
         rest = ~_pose_fill(robot, target, reference, out)
-        if not rest.any():  # every target has its exact branches, each within REACH_TOLERANCE
-            q, valid, within, perr, oerr = out
-            distance = smallest_errors(perr)
-            reachable = np.ones(n, dtype=np.bool_)
-            for array in (q, valid, within, perr, oerr, reachable, distance):
-                array.setflags(write=False)
-            return RobotIkBatch(
-                q, valid, within, perr, oerr, reachable, distance, branch_names(slots)
+        # every target has its exact branches, each within REACH_TOLERANCE: nothing to add
+        exact_everywhere = not rest.any()
+    if exact_everywhere:
+        q, valid, within, perr, oerr = out
+        distance = smallest_errors(perr)
+        reachable = np.ones(n, dtype=np.bool_)
+    else:
+        if rest is None or rest.all():
+            _kernel(robot, target, reference, out)
+        elif rest.any():
+            sub = type(target)(
+                np.ascontiguousarray(target.poses[rest]),
+                target.kind,
+                target.pitch[rest],
+                target.roll[rest],
             )
-    if rest is None or rest.all():
-        _kernel(robot, target, reference, out)
-    elif rest.any():
-        sub = type(target)(
-            np.ascontiguousarray(target.poses[rest]),
-            target.kind,
-            target.pitch[rest],
-            target.roll[rest],
-        )
-        ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[rest])
-        part = out.rows(rest)
-        _kernel(robot, sub, ref, part)
-        out.put(rest, part)
-    rescue_near_axis(robot, target, out)
-    q, valid, within, perr, oerr = out
-    distance = np.where(valid, perr, np.inf).min(axis=1)
-    reachable = distance <= REACH_TOLERANCE
-    # a reachable target's solutions are the branches that reach it; the others are dropped
-    valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
+            ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[rest])
+            part = out.rows(rest)
+            _kernel(robot, sub, ref, part)
+            out.put(rest, part)
+        rescue_near_axis(robot, target, out)
+        q, valid, within, perr, oerr = out
+        distance = np.where(valid, perr, np.inf).min(axis=1)
+        reachable = distance <= REACH_TOLERANCE
+        # a reachable target's solutions are the branches that reach it; the others are dropped
+        valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)
     return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
