@@ -85,16 +85,19 @@ def sphere_gap(p: int, model: Any, scratch: Any) -> float:
     kinds, poses_b, obstacle_half = model[10], model[12], model[13]
     poses = scratch[3]
     a, b = pairs[p, 0], pairs[p, 1]
-    pa = poses[a]
     if pairs[p, 2] == 1:
-        return centre_gap(pa, prim_radius[a], poses[b], prim_radius[b])
-    pose = poses_b[b]
+        return centre_gap(poses, a, prim_radius[a], poses, b, prim_radius[b])
     if kinds[b] == OBSTACLE_SPHERE:
-        return centre_gap(pa, prim_radius[a], pose, obstacle_half[b, 0])
+        return centre_gap(poses, a, prim_radius[a], poses_b, b, obstacle_half[b, 0])
     total = 0.0
-    dx, dy, dz = pa[0, 3] - pose[0, 3], pa[1, 3] - pose[1, 3], pa[2, 3] - pose[2, 3]
+    dx = poses[a, 0, 3] - poses_b[b, 0, 3]
+    dy = poses[a, 1, 3] - poses_b[b, 1, 3]
+    dz = poses[a, 2, 3] - poses_b[b, 2, 3]
     for k in range(3):
-        excess = abs(pose[0, k] * dx + pose[1, k] * dy + pose[2, k] * dz) - obstacle_half[b, k]
+        excess = (
+            abs(poses_b[b, 0, k] * dx + poses_b[b, 1, k] * dy + poses_b[b, 2, k] * dz)
+            - obstacle_half[b, k]
+        )
         if excess > 0.0:
             total += excess * excess
     box_gap: float = math.sqrt(total) - prim_radius[a]

@@ -75,7 +75,7 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
     del prims
     return (
         np.empty((joints, 4, 4)),
-        np.empty((4, 4)),
+        np.empty((1, 4, 4)),
         np.zeros((4, 4)),
         np.empty((len(model[4]), 4, 4)),
         np.empty(pairs),

@@ -38,7 +38,6 @@ from typing import Any
 import numba
 import numpy as np
 
-from lynxplan.collision._kernels import _multiply
 from lynxplan.collision.world import CollisionWorld
 from lynxplan.planning.kernel_model import (
     OBSTACLE_SPHERE,
@@ -113,7 +112,20 @@ class ValidityChecker:
 # -- compiled kernels ---------------------------------------------------------------------------
 
 
-_compose = _multiply  # out = a @ b for 4x4 rigid transforms (the collision kernels' own)
+@numba.njit(cache=True, inline="always")
+def _compose_into(a: np.ndarray, i: int, b: np.ndarray, j: int, out: np.ndarray, k: int) -> None:
+    """out[k] = a[i] @ b[j] for 4x4 rigid transforms (bottom row 0 0 0 1); a, b, out: (n, 4, 4)
+    stacks, indexed here rather than sliced (a slice of an array costs two atomic reference
+    counts in compiled code: the hot loops take none)."""
+    for r in range(3):
+        a0, a1, a2 = a[i, r, 0], a[i, r, 1], a[i, r, 2]
+        for c in range(4):
+            out[k, r, c] = a0 * b[j, 0, c] + a1 * b[j, 1, c] + a2 * b[j, 2, c]
+        out[k, r, 3] += a[i, r, 3]
+    out[k, 3, 0] = 0.0
+    out[k, 3, 1] = 0.0
+    out[k, 3, 2] = 0.0
+    out[k, 3, 3] = 1.0
 
 
 @numba.njit(cache=True, inline="always")
@@ -130,7 +142,7 @@ def joint_poses_upto(q: np.ndarray, model: Any, scratch: Any, last: int) -> None
     The joint rotation is applied to the placement's columns directly (a rotation about one
     axis mixes two columns), then composed with the parent's pose.
     """
-    axes, index_q, parents, joint_placements = model[:4]
+    axes, index_q, parents, placement = model[:4]
     world, local = scratch[0], scratch[1]
     for i in range(4):
         for j in range(4):
@@ -140,20 +152,19 @@ def joint_poses_upto(q: np.ndarray, model: Any, scratch: Any, last: int) -> None
         c, s = math.cos(angle), math.sin(angle)
         a = axes[j]
         i1, i2 = (a + 1) % 3, (a + 2) % 3
-        placement = joint_placements[j]
         for r in range(3):
-            first, second = placement[r, i1], placement[r, i2]
-            local[r, i1] = c * first + s * second
-            local[r, i2] = c * second - s * first
-            local[r, a] = placement[r, a]
-            local[r, 3] = placement[r, 3]
-        _compose(world[parents[j]], local, world[j])
+            first, second = placement[j, r, i1], placement[j, r, i2]
+            local[0, r, i1] = c * first + s * second
+            local[0, r, i2] = c * second - s * first
+            local[0, r, a] = placement[j, r, a]
+            local[0, r, 3] = placement[j, r, 3]
+        _compose_into(world, parents[j], local, 0, world, j)
 
 
 @numba.njit(cache=True, inline="always")
 def primitive_pose(g: int, model: Any, scratch: Any) -> None:
     """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
-    _compose(scratch[0][model[4][g]], model[5][g], scratch[3][g])
+    _compose_into(scratch[0], model[4][g], model[5], g, scratch[3], g)
 
 
 @numba.njit(cache=True)
@@ -166,33 +177,49 @@ def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
 
 @numba.njit(cache=True)
 def _separating_axis_gap(
-    pa: np.ndarray, ha: np.ndarray, pb: np.ndarray, hb: np.ndarray, r: np.ndarray
+    pa: np.ndarray,
+    ia: int,
+    ha: np.ndarray,
+    pb: np.ndarray,
+    ib: int,
+    hb: np.ndarray,
+    jb: int,
+    r: np.ndarray,
 ) -> float:
     """Largest projected gap of two oriented boxes over the SAT axes (a distance lower bound).
 
-    pa, pb: box poses (4, 4) (rotation columns = box axes); ha, hb: half sizes (3,); r: scratch
-    (3, 3). The 9 edge-edge axes are only tried when the 6 face axes leave a gap below
-    :data:`EDGE_AXES_BELOW` (any subset of axes gives a valid bound).
+    Box a: pose pa[ia] (4, 4) (rotation columns = box axes), half sizes ha[ia] (3,); box b: pose
+    pb[ib], half sizes hb[jb]; r: scratch (3, 3). The stacks are indexed here, not sliced (no
+    reference counting in the hot loops). The 9 edge-edge axes are only tried when the 6 face
+    axes leave a gap below :data:`EDGE_AXES_BELOW` (any subset of axes gives a valid bound).
     """
-    t0, t1, t2 = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
+    t0 = pb[ib, 0, 3] - pa[ia, 0, 3]
+    t1 = pb[ib, 1, 3] - pa[ia, 1, 3]
+    t2 = pb[ib, 2, 3] - pa[ia, 2, 3]
     for i in range(3):
         for j in range(3):
-            r[i, j] = abs(pa[0, i] * pb[0, j] + pa[1, i] * pb[1, j] + pa[2, i] * pb[2, j])
+            r[i, j] = abs(
+                pa[ia, 0, i] * pb[ib, 0, j]
+                + pa[ia, 1, i] * pb[ib, 1, j]
+                + pa[ia, 2, i] * pb[ib, 2, j]
+            )
+    a0, a1, a2 = ha[ia, 0], ha[ia, 1], ha[ia, 2]
+    b0, b1, b2 = hb[jb, 0], hb[jb, 1], hb[jb, 2]
     best = -np.inf
     for i in range(3):  # axes of box a
-        proj = abs(pa[0, i] * t0 + pa[1, i] * t1 + pa[2, i] * t2)
-        gap = proj - ha[i] - hb[0] * r[i, 0] - hb[1] * r[i, 1] - hb[2] * r[i, 2]
+        proj = abs(pa[ia, 0, i] * t0 + pa[ia, 1, i] * t1 + pa[ia, 2, i] * t2)
+        gap = proj - ha[ia, i] - b0 * r[i, 0] - b1 * r[i, 1] - b2 * r[i, 2]
         best = max(best, gap)
     for j in range(3):  # axes of box b
-        proj = abs(pb[0, j] * t0 + pb[1, j] * t1 + pb[2, j] * t2)
-        gap = proj - hb[j] - ha[0] * r[0, j] - ha[1] * r[1, j] - ha[2] * r[2, j]
+        proj = abs(pb[ib, 0, j] * t0 + pb[ib, 1, j] * t1 + pb[ib, 2, j] * t2)
+        gap = proj - hb[jb, j] - a0 * r[0, j] - a1 * r[1, j] - a2 * r[2, j]
         best = max(best, gap)
     if best >= EDGE_AXES_BELOW:
         return best
     for i in range(3):  # cross products a_i x b_j, normalised
-        ax0, ax1, ax2 = pa[0, i], pa[1, i], pa[2, i]
+        ax0, ax1, ax2 = pa[ia, 0, i], pa[ia, 1, i], pa[ia, 2, i]
         for j in range(3):
-            bx0, bx1, bx2 = pb[0, j], pb[1, j], pb[2, j]
+            bx0, bx1, bx2 = pb[ib, 0, j], pb[ib, 1, j], pb[ib, 2, j]
             l0 = ax1 * bx2 - ax2 * bx1
             l1 = ax2 * bx0 - ax0 * bx2
             l2 = ax0 * bx1 - ax1 * bx0
@@ -201,30 +228,35 @@ def _separating_axis_gap(
                 continue
             gap = abs(l0 * t0 + l1 * t1 + l2 * t2)
             for k in range(3):
-                gap -= ha[k] * abs(l0 * pa[0, k] + l1 * pa[1, k] + l2 * pa[2, k])
-                gap -= hb[k] * abs(l0 * pb[0, k] + l1 * pb[1, k] + l2 * pb[2, k])
+                gap -= ha[ia, k] * abs(l0 * pa[ia, 0, k] + l1 * pa[ia, 1, k] + l2 * pa[ia, 2, k])
+                gap -= hb[jb, k] * abs(l0 * pb[ib, 0, k] + l1 * pb[ib, 1, k] + l2 * pb[ib, 2, k])
             gap /= norm
             best = max(best, gap)
     return best
 
 
 @numba.njit(cache=True, inline="always")
-def _point_box_distance(p: np.ndarray, pose: np.ndarray, half: np.ndarray) -> float:
-    """Distance from point p (3,) to a solid box of pose (4, 4) and half sizes (3,) (0 inside)."""
+def _point_box_distance(
+    p: np.ndarray, ip: int, poses: np.ndarray, g: int, half: np.ndarray
+) -> float:
+    """Distance from point p[ip] (3,) to the solid box of pose poses[g] (4, 4) and half sizes
+    half[g] (3,) (0 inside)."""
     total = 0.0
-    dx, dy, dz = p[0] - pose[0, 3], p[1] - pose[1, 3], p[2] - pose[2, 3]
+    dx = p[ip, 0] - poses[g, 0, 3]
+    dy = p[ip, 1] - poses[g, 1, 3]
+    dz = p[ip, 2] - poses[g, 2, 3]
     for k in range(3):
-        excess = abs(pose[0, k] * dx + pose[1, k] * dy + pose[2, k] * dz) - half[k]
+        excess = abs(poses[g, 0, k] * dx + poses[g, 1, k] * dy + poses[g, 2, k] * dz) - half[g, k]
         if excess > 0.0:
             total += excess * excess
     return math.sqrt(total)
 
 
 @numba.njit(cache=True, inline="always")
-def centre_gap(pa: np.ndarray, ra: float, pb: np.ndarray, rb: float) -> float:
-    """Gap of two bounding spheres: centres at the translations of poses pa, pb (4, 4), radii
-    ra, rb, in [m] (a lower bound of the distance of anything inside them)."""
-    dx, dy, dz = pb[0, 3] - pa[0, 3], pb[1, 3] - pa[1, 3], pb[2, 3] - pa[2, 3]
+def centre_gap(pa: np.ndarray, a: int, ra: float, pb: np.ndarray, b: int, rb: float) -> float:
+    """Gap of two bounding spheres: centres at the translations of poses pa[a], pb[b] (4, 4),
+    radii ra, rb, in [m] (a lower bound of the distance of anything inside them)."""
+    dx, dy, dz = pb[b, 0, 3] - pa[a, 0, 3], pb[b, 1, 3] - pa[a, 1, 3], pb[b, 2, 3] - pa[a, 2, 3]
     gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - ra - rb
     return gap
 
@@ -244,22 +276,21 @@ def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
     kinds, centres, poses_b, obstacle_half, obstacle_radius = model[10:15]
     poses = scratch[3]
     a, b = pairs[p, 0], pairs[p, 1]
-    pa = poses[a]
     skip = min(enough, SAT_SKIP_DISTANCE)
     if pairs[p, 2] == 1:
-        pb = poses[b]
-        gap = centre_gap(pa, prim_radius[a], pb, prim_radius[b])
+        gap = centre_gap(poses, a, prim_radius[a], poses, b, prim_radius[b])
         if gap < skip:
-            sat = _separating_axis_gap(pa, prim_half[a], pb, prim_half[b], scratch[8])
+            sat = _separating_axis_gap(poses, a, prim_half, poses, b, prim_half, b, scratch[8])
             gap = max(gap, sat)
         return float(gap)
     if kinds[b] == OBSTACLE_SPHERE:
-        return float(_point_box_distance(centres[b], pa, prim_half[a]) - obstacle_half[b, 0])
-    c = centres[b]
-    dx, dy, dz = c[0] - pa[0, 3], c[1] - pa[1, 3], c[2] - pa[2, 3]
+        return float(_point_box_distance(centres, b, poses, a, prim_half) - obstacle_half[b, 0])
+    dx = centres[b, 0] - poses[a, 0, 3]
+    dy = centres[b, 1] - poses[a, 1, 3]
+    dz = centres[b, 2] - poses[a, 2, 3]
     gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - obstacle_radius[b]
     if gap < skip:
-        sat = _separating_axis_gap(pa, prim_half[a], poses_b[b], obstacle_half[b], scratch[8])
+        sat = _separating_axis_gap(poses, a, prim_half, poses_b, b, obstacle_half, b, scratch[8])
         gap = max(gap, sat)
     return float(gap)
 
