@@ -37,6 +37,7 @@ import numpy as np
 
 from lynxplan.planning.edge_walk import (
     STEP_GROWTH,
+    copy_row,
     farthest_lane,
     lever_arms,
     place_lanes,
@@ -56,6 +57,7 @@ from lynxplan.planning.lanes import (
 from lynxplan.planning.validity import (
     centre_gap,
     joint_poses,
+    joint_poses_upto,
     pair_bound,
     primitive_pose,
     primitive_poses,
@@ -178,7 +180,7 @@ def _sphere_chain(
         return False
     s, trend = 0.0, 0.0
     out = scratch[17]
-    one = reach_step(gap, p, arms[0], model, scratch)
+    one = reach_step(gap, p, arms, 0, model, scratch)
     for _ in range(SPHERE_STEPS // LANES):
         if s + one >= 1.0 or not place_lanes(s, gap, one, trend, out):
             break
@@ -193,7 +195,7 @@ def _sphere_chain(
             s, gap = t, gap_t
             for j in range(arms.shape[1]):
                 arms[0, j] = out[OUT_ARMS + j, best]
-            one = reach_step(gap, p, arms[0], model, scratch)
+            one = reach_step(gap, p, arms, 0, model, scratch)
             progressed, i = True, best + 1
         if not progressed:
             break
@@ -214,15 +216,16 @@ def _sphere_grid(
     grid point): pairs flagged in todo (P,) that the grid proves apart on every interval
     (:func:`lynxplan.planning.validity.span_motion` between consecutive points) are cleared.
 
-    gaps: (n + 1, P) and arms: (n + 1, P, nq) work arrays; n = gaps.shape[0] - 1.
+    gaps: (n + 1, P) and arms: ((n + 1) P, nq) work arrays (row i P + p: pair p at point i);
+    n = gaps.shape[0] - 1.
     """
-    intervals = gaps.shape[0] - 1
+    intervals, count = gaps.shape[0] - 1, gaps.shape[1]
     for i in range(intervals + 1):
         _poses_at(q_a, q_b, i / intervals, model, scratch)
         for p in range(todo.shape[0]):
             if todo[p]:
                 gaps[i, p] = sphere_gap(p, model, scratch)
-                lever_arms(p, scratch[0], scratch[3], model, arms[i, p])
+                lever_arms(p, scratch[0], scratch[3], model, arms, i * count + p)
     side = scratch[13]
     for p in range(todo.shape[0]):
         if not todo[p]:
@@ -232,8 +235,8 @@ def _sphere_grid(
             if gaps[i, p] <= 0.0 or gaps[i + 1, p] <= 0.0:
                 proven = False
                 break
-            side[0, :] = arms[i, p]
-            side[1, :] = arms[i + 1, p]
+            copy_row(side, 0, arms, i * count + p)
+            copy_row(side, 1, arms, (i + 1) * count + p)
             if gaps[i, p] + gaps[i + 1, p] <= span_motion(p, 1.0 / intervals, model, scratch):
                 proven = False
                 break
@@ -274,7 +277,7 @@ def _chain(
             motion[count - 1] = static * (1.0 - s)
             s, b = 1.0, ends[1]
             continue
-        t = min(1.0, s + STEP_GROWTH * reach_step(b, p, arms[0], model, scratch))
+        t = min(1.0, s + STEP_GROWTH * reach_step(b, p, arms, 0, model, scratch))
         bt = _bound_at(q_a, q_b, t, p, model, scratch, 1, False)
         span = span_motion(p, t - s, model, scratch)
         while b + bt <= span and t - s >= MIN_STEP:
@@ -287,7 +290,7 @@ def _chain(
             continue
         motion[count - 1] = span
         s, b = t, bt
-        arms[0, :] = arms[1]
+        copy_row(arms, 0, arms, 1)
 
 
 @numba.njit(cache=True)
@@ -306,7 +309,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
     start, end = np.empty((2, count_pairs)), np.empty((2, count_pairs))
     todo = np.empty(count_pairs, dtype=np.bool_)
     gaps = np.empty((SPHERE_GRID + 1, count_pairs))
-    arms = np.empty((SPHERE_GRID + 1, count_pairs, path.shape[1]))
+    arms = np.empty(((SPHERE_GRID + 1) * count_pairs, path.shape[1]))
     count = 0
     for k in range(path.shape[0] - 1):
         for j in range(path.shape[1]):
@@ -354,6 +357,39 @@ def configuration_poses(
         k = segment[r]
         _poses_at(path[k], path[k + 1], parameter[r], model, scratch)
         out[r] = scratch[3]
+
+
+@numba.njit(cache=True)
+def row_transforms(
+    path: np.ndarray,
+    segment: np.ndarray,
+    parameter: np.ndarray,
+    pair: np.ndarray,
+    model: Any,
+    scratch: Any,
+    rotation: np.ndarray,
+    translation: np.ndarray,
+) -> None:
+    """World poses of each row's two primitives at its configuration (the second only for a
+    self pair): rotation (R, 2, 3, 3), translation (R, 2, 3), in [m] (contiguous, ready for
+    coal). Only the joints up to the pair's primitives are posed."""
+    q, pairs, joint_of, poses = scratch[7], model[8], model[4], scratch[3]
+    for r in range(segment.shape[0]):
+        k, s, p = segment[r], parameter[r], pair[r]
+        for j in range(path.shape[1]):
+            q[j] = path[k, j] + s * (path[k + 1, j] - path[k, j])
+        a, b, is_self = pairs[p, 0], pairs[p, 1], pairs[p, 2]
+        last = max(joint_of[a], joint_of[b]) if is_self == 1 else joint_of[a]
+        joint_poses_upto(q, model, scratch, last)
+        primitive_pose(a, model, scratch)
+        if is_self == 1:
+            primitive_pose(b, model, scratch)
+        for side in range(1 + is_self):
+            g = a if side == 0 else b
+            for i in range(3):
+                for j in range(3):
+                    rotation[r, side, i, j] = poses[g, i, j]
+                translation[r, side, i] = poses[g, i, 3]
 
 
 @numba.njit(cache=True)

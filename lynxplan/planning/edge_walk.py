@@ -56,18 +56,29 @@ from lynxplan.planning.validity import (
 
 
 @numba.njit(cache=True, inline="always")
-def lever_arms(p: int, world: np.ndarray, poses: np.ndarray, model: Any, out: np.ndarray) -> None:
+def copy_row(dst: np.ndarray, i: int, src: np.ndarray, k: int) -> None:
+    """dst[i, :] = src[k, :] for 2-D arrays, indexed rather than sliced (a slice costs two
+    atomic reference counts in compiled code)."""
+    for j in range(dst.shape[1]):
+        dst[i, j] = src[k, j]
+
+
+@numba.njit(cache=True, inline="always")
+def lever_arms(
+    p: int, world: np.ndarray, poses: np.ndarray, model: Any, out: np.ndarray, row: int
+) -> None:
     """Lever arm of pair p about each joint at joint poses ``world`` (J, 4, 4) and primitive
-    poses ``poses`` (G, 4, 4) -> out (nq,), in [m]: the largest distance of a point of the
+    poses ``poses`` (G, 4, 4) -> out[row] (nq,), in [m]: the largest distance of a point of the
     primitive that joint j moves (relative to the other side) from joint j's axis, bounded by
     the distance of its centre from the axis plus its bounding radius; 0 when j moves neither.
+    (Rows are indexed, not sliced: no reference counting in the compiled hot loops.)
     """
     axes, radius, owners, joints = model[0], model[7], model[15], model[16]
-    for j in range(out.shape[0]):
+    for j in range(out.shape[1]):
         g = owners[p, j]
         joint = joints[j]
         if g < 0 or joint < 0:
-            out[j] = 0.0
+            out[row, j] = 0.0
             continue
         a = axes[joint]
         w0, w1, w2 = world[joint, 0, a], world[joint, 1, a], world[joint, 2, a]
@@ -75,13 +86,13 @@ def lever_arms(p: int, world: np.ndarray, poses: np.ndarray, model: Any, out: np
         d1 = poses[g, 1, 3] - world[joint, 1, 3]
         d2 = poses[g, 2, 3] - world[joint, 2, 3]
         c0, c1, c2 = w1 * d2 - w2 * d1, w2 * d0 - w0 * d2, w0 * d1 - w1 * d0
-        out[j] = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) + radius[g]
+        out[row, j] = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2) + radius[g]
 
 
 @numba.njit(cache=True, inline="always")
-def reach_step(slack: float, p: int, arms: np.ndarray, model: Any, scratch: Any) -> float:
+def reach_step(slack: float, p: int, arms: np.ndarray, row: int, model: Any, scratch: Any) -> float:
     """Largest ds such that pair p, with ``slack`` [m] above the clearance at s and lever arms
-    ``arms`` (nq,) there, provably keeps the clearance on [s, s + ds] (one-sided).
+    ``arms[row]`` (nq,) there, provably keeps the clearance on [s, s + ds] (one-sided).
 
     A point of the moving primitive moves at most ``sum_j |dq_j| rho_j`` per unit s, rho_j its
     distance from joint j's axis; rho_j at s is at most ``arms[j]``, never more than the static
@@ -95,7 +106,7 @@ def reach_step(slack: float, p: int, arms: np.ndarray, model: Any, scratch: Any)
     for j in range(dq.shape[0]):
         if rates[p, j] > 0.0:
             static += rates[p, j] * dq[j]
-            lever += min(rates[p, j], arms[j]) * dq[j]
+            lever += min(rates[p, j], arms[row, j]) * dq[j]
             spread += dq[j]
     if static <= 0.0:
         return np.inf
@@ -139,7 +150,7 @@ def pose_pair_at(
     primitive_pose(pairs[p, 0], model, scratch)
     if pairs[p, 2] == 1:
         primitive_pose(pairs[p, 1], model, scratch)
-    lever_arms(p, scratch[0], scratch[3], model, scratch[13][side])
+    lever_arms(p, scratch[0], scratch[3], model, scratch[13], side)
 
 
 @numba.njit(cache=True, inline="always")
@@ -285,11 +296,11 @@ def _walk_start(
                 if mid + end[p] > 0.5 * static:
                     continue  # both halves certified
                 where[p], slack[p] = 0.5, mid
-                all_arms[p, :] = rates[p]  # lever arms at most the static reach
-                reach[p] = 0.5 + reach_step(mid, p, all_arms[p], model, scratch)
+                copy_row(all_arms, p, rates, p)  # lever arms at most the static reach
+                reach[p] = 0.5 + reach_step(mid, p, all_arms, p, model, scratch)
                 continue
-        lever_arms(p, scratch[0], scratch[3], model, all_arms[p])
-        reach[p] = reach_step(slack[p], p, all_arms[p], model, scratch)
+        lever_arms(p, scratch[0], scratch[3], model, all_arms, p)
+        reach[p] = reach_step(slack[p], p, all_arms, p, model, scratch)
     return True
 
 
@@ -388,7 +399,7 @@ def _lane_run(
     counters[2] += LANES
     nq = q_a.shape[0]
     accepted, i = 0, 0
-    own = reach_step(sigma, p, arms[0], model, scratch)
+    own = reach_step(sigma, p, arms, 0, model, scratch)
     while i < LANES:
         best = farthest_lane(
             i, s, sigma, own, p, model, scratch, OUT_BOUND, clearance, STALL_DISTANCE
@@ -406,7 +417,7 @@ def _lane_run(
         s, sigma = t, sigma_t
         for j in range(nq):
             arms[0, j] = out[OUT_ARMS + j, best]
-        own = reach_step(sigma, p, arms[0], model, scratch)
+        own = reach_step(sigma, p, arms, 0, model, scratch)
         accepted += 1
         i = best + 1
         if s >= 1.0:
@@ -414,7 +425,7 @@ def _lane_run(
     if accepted == 0:
         return 0.0
     where[p], slack[p] = s, sigma
-    all_arms[p, :] = arms[0]
+    copy_row(all_arms, p, arms, 0)
     reach[p] = s + own
     return 1.0
 
@@ -465,7 +476,7 @@ def edge_walk(
         speed = slack[p] / one
         closing = speed - min(max(trend[p], -speed), speed)
         span = STEP_GROWTH * slack[p] / closing if closing > 0.0 else MAX_GROWTH * one
-        arms[0, :] = all_arms[p]
+        copy_row(arms, 0, all_arms, p)
         if lanes:
             run = _lane_run(q_a, q_b, p, nearest, model, scratch, clearance)
             if run > 0.0:
@@ -481,8 +492,8 @@ def edge_walk(
             ):
                 trend[p] = (slack_t - slack[p]) / (t - s)
                 where[p], slack[p] = t, slack_t
-                all_arms[p, :] = arms[1]
-                reach[p] = t + reach_step(slack_t, p, all_arms[p], model, scratch)
+                copy_row(all_arms, p, arms, 1)
+                reach[p] = t + reach_step(slack_t, p, all_arms, p, model, scratch)
                 continue
         slack_t = _pair_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
         if slack_t <= STALL_DISTANCE:
@@ -490,8 +501,8 @@ def edge_walk(
             return nearest
         trend[p] = (slack_t - slack[p]) / one
         where[p], slack[p] = nearest, slack_t
-        all_arms[p, :] = arms[1]
-        reach[p] = nearest + reach_step(slack_t, p, all_arms[p], model, scratch)
+        copy_row(all_arms, p, arms, 1)
+        reach[p] = nearest + reach_step(slack_t, p, all_arms, p, model, scratch)
 
 
 @numba.njit(cache=True)

@@ -37,6 +37,7 @@ from lynxplan.collision import ClearanceRecord, CollisionWorld
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
 from lynxplan.planning.certify import (
     configuration_poses,
+    row_transforms,
     schedule,
     segment_rates,
     waypoint_bounds,
@@ -113,6 +114,37 @@ class ExactVerifier:
         self.queries += 1
         return float(self._functors[pair](first, second, self._request, self._result))
 
+    def exact_rows(
+        self, path: np.ndarray, segment: np.ndarray, parameter: np.ndarray, pair: np.ndarray
+    ) -> np.ndarray:
+        """coal's signed distance of each row's pair at path parameter (segment, s), in [m]:
+        shape (R,). The rows' poses come from one compiled call
+        (:func:`certify.row_transforms`); the loop only hands them to coal."""
+        count = len(segment)
+        rotation = np.empty((count, 2, 3, 3))
+        translation = np.empty((count, 2, 3))
+        row_transforms(
+            path, segment, parameter, pair, self.model, self.scratch, rotation, translation
+        )
+        functors, request, result = self._functors, self._request, self._result
+        links, obstacles, rows = self._link_poses, self._obstacle_poses, self._rows
+        out = np.empty(count)
+        for r, p in enumerate(pair.tolist()):
+            a, b, is_self = rows[p]
+            first = links[a]
+            first.setRotation(rotation[r, 0])
+            first.setTranslation(translation[r, 0])
+            if is_self:
+                second = links[b]
+                second.setRotation(rotation[r, 1])
+                second.setTranslation(translation[r, 1])
+            else:
+                second = obstacles[b]
+            result.clear()
+            out[r] = functors[p](first, second, request, result)
+        self.queries += count
+        return out
+
     def poses(self, path: np.ndarray, segment: np.ndarray, parameter: np.ndarray) -> np.ndarray:
         """Primitive poses at path parameters (segment, s): shape (R, G, 4, 4)."""
         out = np.empty((len(segment), len(self.world.links), 4, 4))
@@ -179,22 +211,30 @@ class _PathCheck:
         key = (where, pair)
         if key not in self.known:
             self.known[key] = self.verifier.exact(poses, pair)
-            if self.known[key] <= 0.0 and self.contact is None:
-                link, geometry, other = self.verifier.world.pair_names(pair)
-                self.contact = (
-                    f"{link} ({geometry}) touches {other} at path parameter {where:.4f}, "
-                    f"penetration {-self.known[key] * 1e3:.4f} mm"
-                )
+            if self.known[key] <= 0.0:
+                self._report_contact(where, pair, self.known[key])
         return self.known[key]
+
+    def _report_contact(self, where: float, pair: int, distance: float) -> None:
+        """Record the first contact found (distance <= 0, in [m]) at path parameter where."""
+        if self.contact is None:
+            link, geometry, other = self.verifier.world.pair_names(pair)
+            self.contact = (
+                f"{link} ({geometry}) touches {other} at path parameter {where:.4f}, "
+                f"penetration {-distance * 1e3:.4f} mm"
+            )
 
     def run(self) -> None:
         segment, parameter, pair, motion = self.verifier.schedule(self.path)
-        poses = self.verifier.poses(self.path, segment, parameter)
+        distance = self.verifier.exact_rows(self.path, segment, parameter, pair)
         where = (segment + parameter).tolist()
         pairs = pair.tolist()
-        distance = np.array(
-            [self.distance_at(poses[r], where[r], pairs[r]) for r in range(len(pairs))]
-        )
+        self.known = dict(zip(zip(where, pairs, strict=True), distance.tolist(), strict=True))
+        touching = np.flatnonzero(distance <= 0.0)
+        if touching.size:
+            r = int(touching[0])
+            self._report_contact(where[r], pairs[r], float(distance[r]))
+            return
         self._waypoint_minimum()
         if self.contact is not None or len(pairs) < 2:
             return

@@ -54,7 +54,7 @@ def _moving_corners(checker: ValidityChecker, p: int, q: np.ndarray) -> np.ndarr
 
 def _arms_at(checker: ValidityChecker, p: int, q: np.ndarray, side: int) -> None:
     primitive_poses(q, checker.model, checker.scratch)
-    lever_arms(p, checker.scratch[0], checker.scratch[3], checker.model, checker.scratch[13][side])
+    lever_arms(p, checker.scratch[0], checker.scratch[3], checker.model, checker.scratch[13], side)
 
 
 def test_span_and_step_bounds_cover_the_real_motion(arm: Arm, checker: ValidityChecker) -> None:
@@ -82,7 +82,7 @@ def test_span_and_step_bounds_cover_the_real_motion(arm: Arm, checker: ValidityC
             assert (there + back).max() <= bound + TOLERANCE, (p, s, t)
             # One-sided: within reach_step(slack) of s, nothing moves more than slack.
             slack = 0.25 * max(bound, 1e-6)
-            step = reach_step(slack, p, checker.scratch[13][0], checker.model, checker.scratch)
+            step = reach_step(slack, p, checker.scratch[13], 0, checker.model, checker.scratch)
             inside = u - s <= step
             assert there[inside].max(initial=0.0) <= slack + TOLERANCE, (p, s, step)
             tested += 1
