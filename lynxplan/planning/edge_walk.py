@@ -364,7 +364,7 @@ def farthest_lane(
     return best
 
 
-@numba.njit(cache=True)
+@numba.njit(cache=True, inline="always")
 def _lane_run(
     q_a: np.ndarray,
     q_b: np.ndarray,
@@ -385,6 +385,9 @@ def _lane_run(
     (:func:`reach_step`) — and whose slack exceeds :data:`STALL_DISTANCE`; a point with less
     slack is a wall the run does not pass. Updates the pair's state (where, slack, arms, trend,
     reach) as single steps would.
+
+    Inlined into :func:`edge_walk` (a compiled call passing the model and scratch tuples costs
+    an atomic reference count per array at its entry and exits, on every run).
 
     Returns 1 when a point was accepted; -t when the first point t lies within the pair's
     one-sided reach ``nearest`` (certified to t) and its slack is within STALL_DISTANCE (the
