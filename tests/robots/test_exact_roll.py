@@ -9,15 +9,18 @@ ideal one, and FK -> IK round trips find the start configuration among the branc
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from lynxplan.robots import Robot
+from lynxplan.robots import Robot, load_robot
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.exact_roll_equation import exact_roll_equation
 from lynxplan.robots.ik.family_geometry import MODE_APPROACH
 from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms, roll_equation
 from lynxplan.robots.ik.roll_search import EXACT_BAND
+from tests.robots.urdf_factory import tilted_urdf, write_random_family_urdfs
 
 #: The start configuration is a branch when every joint agrees to this [rad], or to
 #: DOUBLE_ROOT on a double root of the roll equation (1 in ~50,000 SO-101 targets).
@@ -122,6 +125,23 @@ def test_approach_round_trips_find_the_start_branch(so101: Robot) -> None:
     q = so101.random_configurations(10_000, seed=7)
     found = _start_found(so101, q)
     assert found.all(), q[~found][:3]
+
+
+def test_approach_round_trips_on_random_near_family_urdfs(tmp_path: Path) -> None:
+    """Random arms with off-axis tools, tilted 4e-6 rad off the family like the SO-101: the
+    start configuration of every approach target is a branch."""
+    paths = write_random_family_urdfs(tmp_path, 6, seed=31)
+    tested = 0
+    for path in paths:
+        robot = load_robot(tilted_urdf(path), tool="tool")
+        assert robot.family is not None and not robot.family.exact
+        if robot.family.tool_on_roll_axis:
+            continue
+        q = robot.random_configurations(2_000, seed=tested)
+        found = _start_found(robot, q)
+        assert found.all(), (path.name, q[~found][:3])
+        tested += 1
+    assert tested >= 3
 
 
 @pytest.mark.slow
