@@ -120,6 +120,8 @@ def test_bench_one_robot(
     assert all(name.startswith("so100 ") for name in names), names
     trips = next(f for f in figures if "round trips solved" in f["name"])
     assert trips["value"] == 100.0 and trips["met"] is True
+    approach = next(f for f in figures if "approach targets" in f["name"])
+    assert approach["value"] == 100.0 and approach["met"] is True
     assert any("speed-up over Pinocchio CLIK" in name for name in names)
     assert main(["bench", "--robot", "so100", "--urdf", "x.urdf"]) == 2  # one or the other
     assert main(["bench", "arm", "--robot", "so100"]) == 2
