@@ -504,8 +504,9 @@ def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
         first += 1
     if first > m:
         return count
-    ys, es = np.empty(2 * m + 2), np.empty(2 * m + 2)
-    edges = np.empty(2 * m + 2, dtype=np.int64)
+    # the samples of a stretch, and at most two reach boundaries per gap between them
+    ys, es = np.empty(2 * m + 4), np.empty(2 * m + 4)
+    edges = np.empty(2 * m + 4, dtype=np.int64)
     aside = np.empty(MAX_ROOTS)
     i = first
     while i <= m:
