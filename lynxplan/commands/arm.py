@@ -146,6 +146,8 @@ def handle_ik(args: argparse.Namespace) -> int:
             {
                 "solutions": solutions,
                 "selected": selected,
+                # branches not listed (outside the joint limits; --all lists them)
+                "outside_limits_not_listed": len(result.solutions) - len(solutions),
                 "orientation_residual": result.orientation_residual,
                 "units": {**units, "orientation_error": "rad", "position_error": units["length"]},
             }

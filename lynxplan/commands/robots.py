@@ -216,6 +216,8 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
                 "distance": result.distance / length,
                 "solutions": solutions,
                 "selected": selected,
+                # branches not listed (outside the joint limits; --all lists them)
+                "outside_limits_not_listed": len(result.solutions) - len(solutions),
                 "orientation_residual": result.orientation_residual,
                 "verification": "every branch: Pinocchio frame placement == solver FK to 1e-12 m",
                 "units": {

@@ -41,7 +41,8 @@ LIMIT_TOL = 47
 OFF_AXIS = 48
 RT0 = 49  # 9 entries, row-major tool rotation at q = 0
 EXACT = 58
-N_PARAMS = 59
+DEVIATION = 59  # the largest angle the model misses the ideal family by [rad]
+N_PARAMS = 60
 
 
 @dataclass(frozen=True)
@@ -175,6 +176,7 @@ def recognise_family(  # noqa: PLR0915 (one pass over the zero configuration, ke
     deviation = max(checks.values())
     exact = deviation <= FAMILY_EXACT_TOLERANCE
     packed[EXACT] = 1.0 if exact else 0.0
+    packed[DEVIATION] = deviation
     packed.setflags(write=False)
     approach = rt0.T @ r
     return (

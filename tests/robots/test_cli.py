@@ -32,6 +32,22 @@ def test_robot_info_shows_the_family(capsys: pytest.CaptureFixture[str]) -> None
     assert data["joints"][0]["upper"] == pytest.approx(110.0, abs=1e-3)  # type: ignore[index]
 
 
+def test_ik_json_counts_the_branches_outside_the_limits(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Straight down at (0.2, 0, 0.1) the SO-101 reaches only outside its joint limits: no
+    branch listed, and the JSON says how many were left out (``--all`` lists them)."""
+    argv = ["ik", "--robot", "so101", "--position", "0.2", "0", "0.1", "--approach", "0", "0", "-1"]
+    data = _json(capsys, [*argv, "--json"])
+    library = load_robot("so101").ik(position=[0.2, 0, 0.1], approach=[0, 0, -1])
+    outside = sum(not s.within_limits for s in library.solutions)
+    assert outside > 0 and data["solutions"] == []  # type: ignore[index]
+    assert data["outside_limits_not_listed"] == outside  # type: ignore[index]
+    listed = _json(capsys, [*argv, "--json", "--all"])
+    assert len(listed["solutions"]) == len(library.solutions)  # type: ignore[index,arg-type]
+    assert listed["outside_limits_not_listed"] == 0  # type: ignore[index]
+
+
 def test_ik_position_approach_returns_verified_branches(capsys: pytest.CaptureFixture[str]) -> None:
     robot = load_robot("so101")
     q = np.array([0.3, -0.4, 0.8, 0.6, 0.2])
@@ -104,6 +120,8 @@ def test_bench_one_robot(
     assert all(name.startswith("so100 ") for name in names), names
     trips = next(f for f in figures if "round trips solved" in f["name"])
     assert trips["value"] == 100.0 and trips["met"] is True
+    approach = next(f for f in figures if "approach targets" in f["name"])
+    assert approach["value"] == 100.0 and approach["met"] is True
     assert any("speed-up over Pinocchio CLIK" in name for name in names)
     assert main(["bench", "--robot", "so100", "--urdf", "x.urdf"]) == 2  # one or the other
     assert main(["bench", "arm", "--robot", "so100"]) == 2

@@ -20,7 +20,7 @@ from lynxplan.robots.ik import pose_kernel
 from lynxplan.robots.ik.pose_block import pose_block_kernel, smallest_errors
 from lynxplan.robots.results import BranchSlots
 from tests.robots.test_pose_kernel import _near_axis_poses
-from tests.robots.urdf_factory import write_random_family_urdfs
+from tests.robots.urdf_factory import tilted_urdf, write_random_family_urdfs
 
 
 def _both(robot: Robot, poses: np.ndarray, reference: np.ndarray) -> tuple[tuple, tuple, int]:  # type: ignore[type-arg]
@@ -90,23 +90,11 @@ def test_block_kernel_equals_scalar_kernel(name: str) -> None:
         _assert_same(scalar, block)
 
 
-def _tilted(path: Path) -> Path:
-    """The URDF with joint 3's axis tilted by 4e-6 rad, as real URDFs' rounded angles tilt them
-    (the SO-101: 3.7e-6 rad): a model only close to the family, whose branches are polished."""
-    text = path.read_text()
-    start = text.index('<joint name="j3"')
-    at = text.index('rpy="', start) + len('rpy="')
-    roll_end = text.index(" ", at)
-    tilted = path.with_name("tilted_" + path.name)
-    tilted.write_text(text[:at] + repr(float(text[at:roll_end]) + 4e-6) + text[roll_end:])
-    return tilted
-
-
 def test_block_kernel_equals_scalar_kernel_on_random_family_urdfs(tmp_path: Path) -> None:
     """Exact family models (no polish) and the same tilted (polished); tools on and off the
     roll axis."""
     for path in write_random_family_urdfs(tmp_path, 6, seed=7):
-        for urdf in (path, _tilted(path)):
+        for urdf in (path, tilted_urdf(path)):
             robot = load_robot(urdf, tool="tool")
             assert robot.family is not None
             assert robot.family.exact == (urdf == path)

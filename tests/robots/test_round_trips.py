@@ -80,10 +80,17 @@ def test_approach_targets_round_trip(builtin: Robot) -> None:
     gap = np.where(batch.valid[..., None], _wrapped_gap(batch.q, q[:, None, :]), np.inf)
     assert gap.max(axis=2).min(axis=1).max() < 1e-7
     assert np.where(batch.valid, batch.position_error, 0).max() <= POSITION_TOLERANCE
-    # roll free: every branch reaches the position; the approach is exact on some branch
+    # roll free: every branch reaches the position; the approach is exact on some branch, and
+    # the start configuration is a branch
     free = builtin.ik_batch(positions=poses[:, :3, 3], approaches=approach)
     assert free.reachable.all()
     assert np.where(free.valid, free.orientation_error, np.inf).min(axis=1).max() < 1e-9
+    # (a tool on the roll axis leaves the roll to the reference)
+    assert builtin.family is not None
+    joints = 4 if builtin.family.tool_on_roll_axis else 5
+    gap = _wrapped_gap(free.q[..., :joints], q[:, None, :joints])
+    gap = np.where(free.valid[..., None], gap, np.inf)
+    assert gap.max(axis=2).min(axis=1).max() < 1e-7
 
 
 def test_pitch_targets_round_trip(builtin: Robot) -> None:

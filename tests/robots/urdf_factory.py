@@ -113,3 +113,15 @@ def write_random_family_urdfs(folder: Path, count: int, seed: int) -> list[Path]
         path.write_text(random_family_urdf(rng, off_axis_tool=i % 3 != 0))
         paths.append(path)
     return paths
+
+
+def tilted_urdf(path: Path, angle: float = 4e-6) -> Path:
+    """The URDF with joint 3's axis tilted by angle [rad], as real URDFs' rounded angles tilt
+    them (the SO-101: 3.7e-6 rad): a model only close to the family, whose branches are polished."""
+    text = path.read_text()
+    start = text.index('<joint name="j3"')
+    at = text.index('rpy="', start) + len('rpy="')
+    roll_end = text.index(" ", at)
+    tilted = path.with_name("tilted_" + path.name)
+    tilted.write_text(text[:at] + repr(float(text[at:roll_end]) + angle) + text[roll_end:])
+    return tilted

@@ -6,7 +6,9 @@ about the approach axis) or given. When the tool point is off the roll axis and 
 given, the rolls are the roots of one scalar function on the roll joint's range
 (``roll_search.py``); without a root, the roll that comes nearest is used and the residual
 reported. When the model is only close to the family (URDF angles written to 5 digits), each
-closed-form answer is polished by Newton's method on the exact chain (``family_polish.py``).
+closed-form answer is polished by Newton's method on the exact chain (``family_polish.py``), and
+where the ideal roll equation is within the model's deviation of zero its roots are searched on
+the exact chain instead (``exact_roll_equation.py``).
 Every branch is then verified by FK of the exact chain. Angles in [rad], lengths in [m].
 """
 
@@ -33,7 +35,15 @@ from lynxplan.robots.ik.family_polish import (
     settle,
 )
 from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms
-from lynxplan.robots.ik.roll_search import GRID_SIZE, MAX_ROOTS, ROOT_GRID, roll_candidates
+from lynxplan.robots.ik.roll_search import (
+    GRID_SIZE,
+    MAX_ROOTS,
+    ROOT_GRID,
+    exact_candidates,
+    nearest_roll,
+    roll_candidates,
+    sample_roll_grid,
+)
 
 __all__ = [
     "MAX_ROOTS",
@@ -143,10 +153,23 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
             roots[0] = theta_fixed
             rooted = True
             if need_roots:
-                count = roll_candidates(problem, lo5, hi5, roots, grid_x, grid_f)
-                if count < 0:  # no root: the nearest roll, held during the polish
+                m = sample_roll_grid(problem, lo5, hi5, grid_x, grid_f)
+                count = roll_candidates(problem, grid_x, grid_f, m, roots)
+                if not exact:
+                    count = exact_candidates(
+                        problem,
+                        (problem, chain_problem, 0, q, scratch, scratch4, scratch5, trial),
+                        (problem, chain_problem, 1, q, scratch, scratch4, scratch5, trial),
+                        grid_x,
+                        grid_f,
+                        m,
+                        roots,
+                        count,
+                    )
+                if count == 0:  # no root: the nearest roll, held during the polish
                     count, rooted = 1, False
-                    nearest = roots[0]
+                    nearest = nearest_roll(problem, grid_x, grid_f, m)
+                    roots[0] = nearest
                     if not exact and MAX_ROOTS >= 2:
                         # the exact model may still have a close pair of roots the nearly
                         # identical ideal model lacks: try Newton from either side first

@@ -45,49 +45,61 @@ def needs_root_search(robot: Robot, target: Target) -> bool:
 
 def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIkBatch:
     """Every branch of each target (see ``family_kernel``)."""
-    from lynxplan.robots.selection import REACH_TOLERANCE
-
     family = robot.family
     assert family is not None
     n = target.poses.shape[0]
     slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
     out = BranchSlots.empty(n, slots)
-    rest = None
-    exact_everywhere = False
-    if robot._arm is not None and target.kind != fk_.MODE_PITCH:
-        out.clear()
-        rest = ~al5_fill(robot, target, reference, out)
-    elif target.kind == fk_.MODE_POSE:
+    if target.kind == fk_.MODE_POSE and robot._arm is None:
+        # the poses pose_block solves have their exact branches, each within REACH_TOLERANCE;
+        # the rest (out of reach, degenerate) goes through the general kernel
         rest = ~_pose_fill(robot, target, reference, out)
-        # every target has its exact branches, each within REACH_TOLERANCE: nothing to add
-        exact_everywhere = not rest.any()
-    if exact_everywhere:
-        q, valid, within, perr, oerr = out
-        distance = smallest_errors(perr)
+        distance = smallest_errors(out.position_error)
         reachable = np.ones(n, dtype=np.bool_)
-    else:
-        if rest is None or rest.all():
-            _kernel(robot, target, reference, out)
-        elif rest.any():
-            sub = type(target)(
-                np.ascontiguousarray(target.poses[rest]),
-                target.kind,
-                target.pitch[rest],
-                target.roll[rest],
-            )
-            ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[rest])
+        if rest.any():
+            sub, ref = _rows(target, reference, rest)
             part = out.rows(rest)
             _kernel(robot, sub, ref, part)
+            reachable[rest], distance[rest] = _general(robot, sub, part)
             out.put(rest, part)
-        rescue_near_axis(robot, target, out)
-        q, valid, within, perr, oerr = out
-        distance = np.where(valid, perr, np.inf).min(axis=1)
-        reachable = distance <= REACH_TOLERANCE
-        # a reachable target's solutions are the branches that reach it; the others are dropped
-        valid &= ~(reachable[:, None] & (perr > REACH_TOLERANCE))
+    else:
+        if robot._arm is not None and target.kind != fk_.MODE_PITCH:
+            out.clear()
+            rest = ~al5_fill(robot, target, reference, out)
+            if rest.any():
+                sub, ref = _rows(target, reference, rest)
+                part = out.rows(rest)
+                _kernel(robot, sub, ref, part)
+                out.put(rest, part)
+        else:
+            _kernel(robot, target, reference, out)
+        reachable, distance = _general(robot, target, out)
+    q, valid, within, perr, oerr = out
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)
     return RobotIkBatch(q, valid, within, perr, oerr, reachable, distance, branch_names(slots))
+
+
+def _rows(target: Target, reference: np.ndarray, mask: np.ndarray) -> tuple[Target, np.ndarray]:
+    """The targets in ``mask`` (N,) bool and their references."""
+    sub = type(target)(
+        np.ascontiguousarray(target.poses[mask]), target.kind, target.pitch[mask], target.roll[mask]
+    )
+    ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[mask])
+    return sub, ref
+
+
+def _general(robot: Robot, target: Target, out: BranchSlots) -> tuple[np.ndarray, np.ndarray]:
+    """After the general kernel: the near-axis rescue, then which targets are reachable (N,)
+    bool and their distance (N,) [m] (the smallest branch position error); a reachable target's
+    solutions are the branches that reach it (the others are dropped from ``out``)."""
+    from lynxplan.robots.selection import REACH_TOLERANCE
+
+    rescue_near_axis(robot, target, out)
+    distance = np.where(out.valid, out.position_error, np.inf).min(axis=1)
+    reachable = distance <= REACH_TOLERANCE
+    out.valid[...] &= ~(reachable[:, None] & (out.position_error > REACH_TOLERANCE))
+    return reachable, distance
 
 
 #: Targets this much closer to the yaw axis than the wrist's lateral offset plus the tool's

@@ -11,11 +11,18 @@ hide in its cells). Without a root, the roll that comes nearest is used. Angles 
 from __future__ import annotations
 
 import math
+from typing import Any
 
 import numba
 import numpy as np
+from numba.extending import overload
 
 from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.ik.exact_roll_equation import (
+    ExactProblem,
+    branch_reaches,
+    exact_roll_equation,
+)
 from lynxplan.robots.ik.family_geometry import MODE_APPROACH, RollProblem
 from lynxplan.robots.ik.roll_equation import (
     lateral_miss,
@@ -45,25 +52,65 @@ MAX_ROOTS = 6
 GRID_SIZE = ROOT_GRID * (BOUNDARY_SAMPLES + SUBDIVISION) + 2
 #: Brent's minimisation: relative and absolute tolerance on the minimiser [rad].
 _BRENT_RELATIVE, _BRENT_ABSOLUTE = 1.5e-8, 1e-11
+#: A model only close to the family: where the ideal equation is below this many times the
+#: model's deviation (times 1 + d / rho, d the target's distance from the shoulder, rho the
+#: wrist circle's radius), the roots are searched on the exact chain (``exact_roll_equation.py``).
+EXACT_BAND = 16.0
+#: Roots of the two elbows' exact equations closer than this are one root [rad] (each elbow's
+#: branch is then polished from it).
+ROOT_MERGE = 1e-6
+#: Roots of the exact equation are refined until a step is below this [rad].
+EXACT_ROOT_STEP = 1e-9
+#: The reach boundary of an exact branch is located to this [rad].
+BOUNDARY_TOLERANCE = 1e-7
+
+
+def equation(problem: RollProblem | ExactProblem, theta: float) -> float:
+    """The roll equation at theta: the ideal one (``RollProblem``) or the exact chain's
+    (``ExactProblem``). Compiled code calls the overload below."""
+    if len(problem) == 7:
+        return float(roll_equation(problem, theta))
+    return float(exact_roll_equation(problem, theta))
+
+
+@overload(equation)
+def _equation_overload(problem: Any, theta: Any) -> Any:
+    # the implementations repeat the overload's signature, annotations included (numba checks)
+    if len(problem.types) == 7:
+
+        def ideal(problem: Any, theta: Any) -> Any:
+            return roll_equation(problem, theta)
+
+        return ideal
+
+    def exact(problem: Any, theta: Any) -> Any:
+        return exact_roll_equation(problem, theta)
+
+    return exact
 
 
 @numba.njit(cache=True, nogil=True)
 def _refine_root(
-    problem: RollProblem,
+    problem: RollProblem | ExactProblem,
     a: float,
     fa: float,
     b: float,
     fb: float,
 ) -> float:
-    """Illinois regula falsi on a bracket [a, b] with fa * fb < 0."""
+    """Illinois regula falsi on a bracket [a, b] with fa * fb < 0: to the last bit on the
+    ideal equation, to EXACT_ROOT_STEP on the exact one (Newton's method on the exact chain
+    finishes its roots)."""
+    xtol = 0.0 if len(problem) == 7 else EXACT_ROOT_STEP
     side_kept = 0
+    previous = np.inf
     for _ in range(80):
         c = (a * fb - b * fa) / (fb - fa)
         if not (min(a, b) <= c <= max(a, b)):
             c = 0.5 * (a + b)
-        fc = roll_equation(problem, c)
-        if fc == 0.0 or abs(b - a) < 1e-15:
+        fc = equation(problem, c)
+        if fc == 0.0 or abs(b - a) < 1e-15 or abs(c - previous) < xtol:
             return c
+        previous = c
         if (fc > 0) == (fb > 0):
             b, fb = c, fc
             if side_kept == -1:
@@ -81,7 +128,7 @@ def _refine_root(
 
 @numba.njit(cache=True, nogil=True)
 def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
-    problem: RollProblem,
+    problem: RollProblem | ExactProblem,
     a: float,
     b: float,
     sign: float,
@@ -90,7 +137,7 @@ def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
     fallback), or the first point found where sign * f < 0 (then f changes sign in [a, b])."""
     golden = 0.5 * (3.0 - math.sqrt(5.0))
     x = w = v = a + golden * (b - a)
-    fx = sign * roll_equation(problem, x)
+    fx = sign * equation(problem, x)
     if fx < 0.0:
         return x
     fw = fv = fx
@@ -122,7 +169,7 @@ def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
             e = (a - x) if x >= xm else (b - x)
             d = golden * e
         u = x + d if abs(d) >= tol1 else x + (tol1 if d > 0 else -tol1)
-        fu = sign * roll_equation(problem, u)
+        fu = sign * equation(problem, u)
         if fu < 0.0:
             return u
         if fu <= fx:
@@ -164,21 +211,15 @@ def _keep_root(
 
 
 @numba.njit(cache=True, nogil=True)
-def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
+def sample_roll_grid(
     problem: RollProblem,
     lo: float,
     hi: float,
-    roots: np.ndarray,
     xs: np.ndarray,
     fs: np.ndarray,
 ) -> int:
-    """Every root of the roll equation in [lo, hi] (at most MAX_ROOTS); returns their count.
-
-    Roots are bracketed by sign changes on the grid; a pair of roots inside one cell (a near
-    double root) shows as a local minimum of |f| without a sign change: the extremum is located
-    by golden section and both halves bracketed. Without any root, writes the minimiser of |f|
-    and returns -1.
-    """
+    """The roll equation sampled on [lo, hi] into xs, fs (GRID_SIZE,); returns the index m of
+    the last sample (xs[: m + 1] increasing, xs[0] = lo, xs[m] = hi)."""
     # uniform grid; cells where f changes fast are split SUBDIVISION times, and cells where
     # the yaw circle starts or stops being reachable are sampled towards that boundary with a
     # quadratic spacing (f behaves like the square root of the distance to it there)
@@ -223,21 +264,62 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
         m += 1
         xs[m], fs[m] = x1, f1
         c0 = c1
-    count = 0
+    return m
+
+
+@numba.njit(cache=True, nogil=True)
+def roll_candidates(
+    problem: RollProblem,
+    xs: np.ndarray,
+    fs: np.ndarray,
+    m: int,
+    roots: np.ndarray,
+) -> int:
+    """Every root of the roll equation sampled at xs[: m + 1] (``sample_roll_grid``), at most
+    MAX_ROOTS, into roots; returns their count (0 without a root: see ``nearest_roll``).
+
+    Roots are bracketed by sign changes on the grid; a pair of roots inside one cell (a near
+    double root) shows as a local minimum of |f| without a sign change: the extremum is located
+    by Brent's minimisation and both halves bracketed.
+    """
+    near = problem[0][F.EXACT] == 0.0
+    return _scan(problem, problem, xs, fs, m, roots, 0, near, True, True)
+
+
+@numba.njit(cache=True, nogil=True)
+def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
+    problem: RollProblem | ExactProblem,
+    ideal: RollProblem,
+    xs: np.ndarray,
+    fs: np.ndarray,
+    m: int,
+    roots: np.ndarray,
+    count: int,
+    near_roots: bool,
+    lo_end: bool,
+    hi_end: bool,
+) -> int:
+    """The roots of problem's equation sampled at xs[: m + 1] (fs; NaN where undefined) added to
+    roots[:count]; returns the new count. ``near_roots``: a near root of the ideal equation
+    gives two tentative roots; ``lo_end``, ``hi_end``: xs[0], xs[m] are ends of the roll range
+    (an extremum there hides roots)."""
     for i in range(m + 1):
         if count >= MAX_ROOTS:
             break
         if fs[i] == 0.0:
-            count = _keep_root(problem, xs[i], roots, count)
+            count = _keep_root(ideal, xs[i], roots, count)
             continue
         if i == m:
             break
         f0, f1 = fs[i], fs[i + 1]
+        if not (math.isfinite(f0) and math.isfinite(f1)):
+            continue
         if f1 != 0.0 and (f0 < 0.0) != (f1 < 0.0):
             x = _refine_root(problem, xs[i], f0, xs[i + 1], f1)
-            count = _keep_root(problem, x, roots, count)
+            count = _keep_root(ideal, x, roots, count)
         elif (
             i > 0
+            and math.isfinite(fs[i - 1])
             and (fs[i - 1] < 0.0) == (f0 < 0.0)
             and abs(f0) < abs(fs[i - 1])
             and abs(f0) <= abs(f1)
@@ -245,53 +327,255 @@ def roll_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
             # local extremum of |f| at grid point i: two roots may hide in [x_{i-1}, x_{i+1}]
             sign = 1.0 if f0 > 0 else -1.0
             xm = _minimise(problem, xs[i - 1], xs[i + 1], sign)
-            fm = roll_equation(problem, xm)
+            fm = equation(problem, xm)
             if fm == 0.0:
-                count = _keep_root(problem, xm, roots, count)
+                count = _keep_root(ideal, xm, roots, count)
             elif (fm < 0.0) == (f0 < 0.0) and abs(fm) <= TANGENT_TOLERANCE:
                 # a double (tangent) root: f touches zero without crossing it
-                count = _keep_root(problem, xm, roots, count)
-            elif problem[0][F.EXACT] == 0.0 and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
+                count = _keep_root(ideal, xm, roots, count)
+            elif near_roots and (fm < 0.0) == (f0 < 0.0) and abs(fm) < NEAR_ROOT:
                 # the exact model may have a close pair of roots here that the nearly
                 # identical ideal model lacks: tentative, kept only if Newton converges
                 for shift in (-2e-3, 2e-3):
                     before = count
-                    count = _keep_root(problem, xm + shift, roots, count)
+                    count = _keep_root(ideal, xm + shift, roots, count)
                     if count > before:
                         roots[MAX_ROOTS + count - 1] = 1.0
             elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
                 x = _refine_root(problem, xs[i - 1], fs[i - 1], xm, fm)
-                count = _keep_root(problem, x, roots, count)
+                count = _keep_root(ideal, x, roots, count)
                 x = _refine_root(problem, xm, fm, xs[i + 1], f1)
-                count = _keep_root(problem, x, roots, count)
+                count = _keep_root(ideal, x, roots, count)
     # an extremum at either end of the range hides roots the scan above cannot see
-    for lo_i, hi_i, end in ((0, 1, 0), (m - 1, m, m)):
-        inner = 1 if end == 0 else m - 1
-        if (
-            count + 2 <= MAX_ROOTS
-            and m > 0
-            and fs[end] != 0.0
-            and (fs[end] < 0.0) == (fs[inner] < 0.0)
-            and abs(fs[end]) < abs(fs[inner])
-        ):
-            sign = 1.0 if fs[end] > 0 else -1.0
-            xm = _minimise(problem, xs[lo_i], xs[hi_i], sign)
-            fm = roll_equation(problem, xm)
-            if abs(fm) <= TANGENT_TOLERANCE:
-                count = _keep_root(problem, xm, roots, count)
-            elif (fm < 0.0) != (fs[end] < 0.0):
-                x = _refine_root(problem, xs[lo_i], fs[lo_i], xm, fm)
-                count = _keep_root(problem, x, roots, count)
-                x = _refine_root(problem, xm, fm, xs[hi_i], fs[hi_i])
-                count = _keep_root(problem, x, roots, count)
-    if count > 0:
-        return count
-    roots[0] = _nearest_roll(problem, xs, fs, m)
-    return -1
+    if lo_end and m > 0:
+        count = _end_roots(problem, ideal, xs, fs, 0, 1, roots, count)
+    if hi_end and m > 0:
+        count = _end_roots(problem, ideal, xs, fs, m, m - 1, roots, count)
+    return count
 
 
 @numba.njit(cache=True, nogil=True)
-def _nearest_roll(
+def _end_roots(
+    problem: RollProblem | ExactProblem,
+    ideal: RollProblem,
+    xs: np.ndarray,
+    fs: np.ndarray,
+    end: int,
+    inner: int,
+    roots: np.ndarray,
+    count: int,
+) -> int:
+    """The roots an extremum of |f| at the last sample before an end (of the range, or of
+    where the equation is defined) hides between xs[inner] and xs[end]; returns the count."""
+    a, b = min(end, inner), max(end, inner)
+    if (
+        count + 2 <= MAX_ROOTS
+        and fs[end] != 0.0
+        and math.isfinite(fs[end])
+        and math.isfinite(fs[inner])
+        and (fs[end] < 0.0) == (fs[inner] < 0.0)
+        and abs(fs[end]) < abs(fs[inner])
+    ):
+        sign = 1.0 if fs[end] > 0 else -1.0
+        xm = _minimise(problem, xs[a], xs[b], sign)
+        fm = equation(problem, xm)
+        if fm != 0.0 and (fm < 0.0) != (fs[end] < 0.0):
+            x = _refine_root(problem, xs[a], fs[a], xm, fm)
+            count = _keep_root(ideal, x, roots, count)
+            x = _refine_root(problem, xm, fm, xs[b], fs[b])
+            count = _keep_root(ideal, x, roots, count)
+        elif abs(fm) <= TANGENT_TOLERANCE:
+            count = _keep_root(ideal, xm, roots, count)
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _exact_samples(
+    problem: ExactProblem,
+    xs: np.ndarray,
+    fs: np.ndarray,
+    lo: int,
+    hi: int,
+    band: float,
+    ys: np.ndarray,
+    es: np.ndarray,
+    edges: np.ndarray,
+) -> int:
+    """The exact equation at the samples xs[lo : hi + 1] where it is defined, into ys, es;
+    returns the index of the last (-1 if none). edges[k] is the index of the defined neighbour
+    of a sample at a reach boundary, else -1.
+
+    Inside the band it is evaluated (one held polish); outside, the ideal value has its sign.
+    Undefined samples are left out; where the branch stops or starts reaching the target, a
+    sample at the reach boundary is added (``_reach_boundary``), so that a root between it and
+    the nearest defined sample is bracketed.
+    """
+    n = -1
+    last = lo - 1  # the last defined sample
+    for s in range(lo, hi + 1):
+        f = fs[s]
+        if abs(f) < band:
+            f = exact_roll_equation(problem, xs[s])
+        elif not branch_reaches(problem, xs[s]):
+            f = np.nan
+        if not math.isfinite(f):
+            continue
+        if last < s - 1:  # undefined before: the boundaries of the gap
+            if last >= lo:
+                x, fb = _reach_boundary(problem, xs[last], es[n], xs[last + 1])
+                if x != xs[last]:
+                    n += 1
+                    ys[n], es[n], edges[n] = x, fb, n - 1
+            x, fb = _reach_boundary(problem, xs[s], f, xs[s - 1])
+            if x != xs[s]:
+                n += 1
+                ys[n], es[n], edges[n] = x, fb, n + 1
+        last = s
+        n += 1
+        ys[n], es[n], edges[n] = xs[s], f, -1
+    if lo <= last < hi:
+        x, fb = _reach_boundary(problem, xs[last], es[n], xs[last + 1])
+        if x != xs[last]:
+            n += 1
+            ys[n], es[n], edges[n] = x, fb, n - 1
+    return n
+
+
+@numba.njit(cache=True, nogil=True)
+def _reach_boundary(
+    problem: ExactProblem, inner: float, f_inner: float, outer: float
+) -> tuple[float, float]:
+    """The last roll from inner towards outer where the exact equation is defined (it is at
+    inner, f_inner, not at outer), to BOUNDARY_TOLERANCE, and the equation there. The ideal
+    branch's boundary first (bisection on its closed form), then the exact one between it and
+    inner."""
+    a, b = inner, outer
+    for _ in range(60):
+        if abs(b - a) < BOUNDARY_TOLERANCE:
+            break
+        mid = 0.5 * (a + b)
+        if branch_reaches(problem, mid):
+            a = mid
+        else:
+            b = mid
+    f = exact_roll_equation(problem, a)
+    if math.isfinite(f):
+        return a, f
+    outer = a
+    for _ in range(60):
+        if abs(outer - inner) < BOUNDARY_TOLERANCE:
+            break
+        mid = 0.5 * (inner + outer)
+        f = exact_roll_equation(problem, mid)
+        if math.isfinite(f):
+            inner, f_inner = mid, f
+        else:
+            outer = mid
+    return inner, f_inner
+
+
+@numba.njit(cache=True, nogil=True)
+def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
+    problem: RollProblem,
+    elbow0: ExactProblem,
+    elbow1: ExactProblem,
+    xs: np.ndarray,
+    fs: np.ndarray,
+    m: int,
+    roots: np.ndarray,
+    count: int,
+) -> int:
+    """A model only close to the family: the roots on the stretches where the ideal equation
+    (sampled at xs[: m + 1], fs) is within EXACT_BAND deviations of zero are replaced by the
+    exact chain's, searched the same way for each elbow on the same samples; the ideal roots
+    there are kept after them. These roots are tentative (a branch only where Newton converges
+    on the exact chain). Returns the count."""
+    prm, target, g = problem[0], problem[1], problem[2]
+    # the ideal and exact equations differ by up to ~6 deviations times d / rho (a position
+    # error of the model turns the yaw by 1 / rho): measured on the SO-101
+    d = math.sqrt(
+        (target[0, 3] - prm[F.C1]) ** 2
+        + (target[1, 3] - prm[F.C1 + 1]) ** 2
+        + (target[2, 3] - prm[F.C1 + 2]) ** 2
+    )
+    band = EXACT_BAND * prm[F.DEVIATION] * (1.0 + d / max(g[3, 0], 1e-9))
+    first = 0
+    while first <= m and not abs(fs[first]) < band:
+        first += 1
+    if first > m:
+        return count
+    # the samples of a stretch, and at most two reach boundaries per gap between them
+    ys, es = np.empty(2 * m + 4), np.empty(2 * m + 4)
+    edges = np.empty(2 * m + 4, dtype=np.int64)
+    aside = np.empty(MAX_ROOTS)
+    i = first
+    while i <= m:
+        if not abs(fs[i]) < band:
+            i += 1
+            continue
+        j = i
+        while j < m and abs(fs[j + 1]) < band:
+            j += 1
+        lo, hi = max(i - 1, 0), min(j + 1, m)
+        i = j + 1
+        if _simple_crossing(fs, lo, hi, m):
+            continue  # one well-conditioned root: the ideal one, polished on the exact chain
+        kept = dropped = 0  # the ideal roots of the stretch: set aside, tried last
+        for r in range(count):
+            if not xs[lo] <= roots[r] <= xs[hi]:
+                roots[kept], roots[MAX_ROOTS + kept] = roots[r], roots[MAX_ROOTS + r]
+                kept += 1
+            else:
+                aside[dropped] = roots[r]
+                dropped += 1
+        count = kept
+        start = count
+        for exact in (elbow0, elbow1):
+            n = _exact_samples(exact, xs, fs, lo, hi, band, ys, es, edges)
+            if n < 1:
+                continue
+            before = count
+            count = _scan(
+                exact, problem, ys, es, n, roots, count, False, ys[0] == xs[0], ys[n] == xs[m]
+            )
+            for k in range(n + 1):
+                if edges[k] >= 0:
+                    count = _end_roots(exact, problem, ys, es, k, edges[k], roots, count)
+            kept = before
+            for r in range(before, count):  # the other elbow's roots already found
+                seen = False
+                for t in range(start, before):
+                    seen = seen or abs(roots[r] - roots[t]) < ROOT_MERGE
+                if not seen:
+                    roots[kept], roots[MAX_ROOTS + kept] = roots[r], 1.0
+                    kept += 1
+            count = kept
+        # the ideal roots stay candidates too (a root at a reach boundary, where the exact
+        # equation is defined on one side only, may be bracketed by neither), tentative
+        for r in range(dropped):
+            before = count
+            count = _keep_root(problem, aside[r], roots, count)
+            if count > before:
+                roots[MAX_ROOTS + count - 1] = 1.0
+    return count
+
+
+@numba.njit(cache=True, nogil=True)
+def _simple_crossing(fs: np.ndarray, lo: int, hi: int, m: int) -> bool:
+    """Whether the samples fs[lo : hi + 1] are strictly monotone with one sign change, away from
+    the ends of the range [0, m]: then the exact equation, within the band of the ideal one,
+    has the one root the ideal equation has, next to it."""
+    if lo == 0 or hi == m:
+        return False
+    rising = fs[hi] > fs[lo]
+    for k in range(lo, hi):
+        if not ((fs[k + 1] > fs[k]) == rising and fs[k + 1] != fs[k]):
+            return False
+    return bool((fs[lo] < 0.0) != (fs[hi] < 0.0))
+
+
+@numba.njit(cache=True, nogil=True)
+def nearest_roll(
     problem: RollProblem,
     xs: np.ndarray,
     fs: np.ndarray,
