@@ -129,3 +129,25 @@ def test_closest_contact_and_sample_clearances_are_the_exact_minimum(
             names = collision_world.pair_names(pair)
             if np.sort(every[n])[1] - every[n, pair] > 2 * COAL_GJK_TOLERANCE:  # one nearest
                 assert (link, other) == (names[0], names[2])
+
+
+def test_exact_rows_are_the_worlds_exact_distances(arm: Arm, world: CollisionWorld) -> None:
+    """The verifier's batched exact queries (poses of only the pair's joints from one compiled
+    call, :func:`lynxplan.planning.certify.row_transforms`) equal the collision world's own
+    exact distances at the same configurations (posed by the world, every pair, self pairs
+    included), in contact and apart."""
+    verifier = verifier_of(world)
+    rng = np.random.default_rng(5)
+    path = _random_path(arm, rng)
+    rows = 60
+    segment = rng.integers(0, len(path) - 1, size=rows)
+    parameter = rng.uniform(0.0, 1.0, size=rows)
+    pair = rng.integers(0, world.pair_count, size=rows)
+    pair[:2] = np.flatnonzero(world.pair_is_self)[:2]  # self pairs set both transforms
+    got = verifier.exact_rows(path, segment, parameter, pair)
+    q = path[segment] + parameter[:, None] * (path[segment + 1] - path[segment])
+    every = world.distances(q)
+    expected = every[np.arange(rows), pair]
+    np.testing.assert_allclose(got, expected, atol=COAL_GJK_TOLERANCE)
+    # The sample reaches contacts and clear pairs alike.
+    assert (every.min(axis=1) < 0).any() and (got > 0).any()
