@@ -102,12 +102,10 @@ class ExactVerifier:
         """coal's signed distance of one pair at primitive poses (G, 4, 4), in [m]."""
         a, b, is_self = self._rows[pair]
         first = self._link_poses[a]
-        first.setRotation(poses[a, :3, :3])
-        first.setTranslation(poses[a, :3, 3])
+        first.setTransform(poses[a, :3, :3], poses[a, :3, 3])
         if is_self:
             second = self._link_poses[b]
-            second.setRotation(poses[b, :3, :3])
-            second.setTranslation(poses[b, :3, 3])
+            second.setTransform(poses[b, :3, :3], poses[b, :3, 3])
         else:
             second = self._obstacle_poses[b]
         self._result.clear()
@@ -132,12 +130,10 @@ class ExactVerifier:
         for r, p in enumerate(pair.tolist()):
             a, b, is_self = rows[p]
             first = links[a]
-            first.setRotation(rotation[r, 0])
-            first.setTranslation(translation[r, 0])
+            first.setTransform(rotation[r, 0], translation[r, 0])
             if is_self:
                 second = links[b]
-                second.setRotation(rotation[r, 1])
-                second.setTranslation(translation[r, 1])
+                second.setTransform(rotation[r, 1], translation[r, 1])
             else:
                 second = obstacles[b]
             result.clear()
@@ -283,7 +279,9 @@ class _PathCheck:
     def minimum(self) -> ClearanceRecord:
         if not self.known:
             return ClearanceRecord(float("inf"), "", "", "", float("nan"), -1)
-        (where, pair), clearance = min(self.known.items(), key=lambda item: item[1])
+        known = self.known
+        where, pair = min(known, key=known.__getitem__)
+        clearance = known[(where, pair)]
         link, geometry, other = self.verifier.world.pair_names(pair)
         sample = int(where) if where == int(where) else -1
         return ClearanceRecord(clearance, link, geometry, other, where, sample)
