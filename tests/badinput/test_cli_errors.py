@@ -81,6 +81,10 @@ def test_ctrl_c_exits_130_with_one_line(tmp_path: Path) -> None:
         "import sys; from lynxplan.cli import main; "
         "sys.argv[0]='lynxplan'; raise SystemExit(main(sys.argv[1:]))"
     )
+    # compile (and cache) the run's numba kernels first: an interrupt during numba's compilation
+    # may be swallowed there, and the run then completes (a cold CI clone)
+    warm = [sys.executable, "-c", code, "workspace", "--samples", "1000", "--out"]
+    subprocess.run([*warm, str(tmp_path / "warm")], env=env, check=True, capture_output=True)
     process = subprocess.Popen(
         [
             sys.executable,
