@@ -24,3 +24,15 @@ def as_rows(values: Any, width: int, name: str) -> np.ndarray:
     if not np.isfinite(array).all():
         raise NonFiniteInputError(name)
     return np.ascontiguousarray(array.reshape(-1, width))
+
+
+def kernel_input(array: np.ndarray) -> np.ndarray:
+    """A read-only, C-contiguous view of a kernel's input array (a copy only when not contiguous).
+
+    numba compiles a kernel once per argument type, and a read-only array, a writable one and a
+    non-contiguous one are three types: passing every input through this keeps one compiled
+    signature per kernel (each costs seconds to tens of seconds of compile on first use).
+    """
+    view = np.ascontiguousarray(array).view()
+    view.setflags(write=False)
+    return view

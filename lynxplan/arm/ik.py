@@ -19,6 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan.arm.geometry import ArmGeometry, JointLimits
 from lynxplan.arm.ik_kernel import (
     FAR_AWAY_K,
@@ -134,12 +135,13 @@ def solve_ik_batch(
         geometry.a2,
         geometry.a3,
         geometry.d5,
-        limits.lower,
-        limits.upper,
+        kernel_input(limits.lower),
+        kernel_input(limits.upper),
         float(limit_tolerance),
         bool(approach_only),
     )
-    ik_kernel(poses, ref, params, IkOutputs(q, within, residual, status, miss, deviation))
+    outputs = IkOutputs(q, within, residual, status, miss, deviation)
+    ik_kernel(kernel_input(poses), kernel_input(ref), params, outputs)
     for array in (q, within, residual, status, miss, deviation):
         array.setflags(write=False)
     return IkBatch(q, within, residual, status, miss, deviation)

@@ -98,6 +98,8 @@ def forward_kinematics(
         out = np.empty(shape)
     elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
         raise ShapeError("out", f"{shape}, float64, C-contiguous", out.shape)
+    if not batch.flags.writeable:  # the IK kernels call it with writable rows: one signature
+        batch = batch.copy()
     fk_kernel(batch, geometry.a2, geometry.a3, geometry.d5, out)
     return out[0] if np.ndim(q) == 1 else out
 

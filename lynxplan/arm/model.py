@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any, Literal
 import numpy as np
 
 from lynxplan import guards
+from lynxplan._arrays import kernel_input
 from lynxplan.arm.configuration import as_configurations
 from lynxplan.arm.geometry import TOOL_FRAME
 from lynxplan.arm.ik_result import IkResult, IkSolution
@@ -103,12 +104,10 @@ class Arm:
         self.geometry = read_geometry(self.model)
         self.limits = read_limits(self.model)
         self.tool_frame_id = self.model.getFrameId(TOOL_FRAME)
-        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance, limits.
+        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance; limits.
         g = self.geometry
-        self._ik_params = np.concatenate(
-            ([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE], self.limits.lower, self.limits.upper)
-        )
-        self._ik_params.setflags(write=False)
+        self._ik_params = kernel_input(np.array([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE]))
+        self._ik_limits = kernel_input(self.limits.lower), kernel_input(self.limits.upper)
 
     # -- geometry models (collision and visual), built on first use ------------------------------
     @cached_property
@@ -260,7 +259,15 @@ class Arm:
             params = params.copy()
             params[3] = limit_tolerance
         ik = _ik()
-        ik.ik_single_kernel(pose, reference, params, flags, rows, scalars)
+        ik.ik_single_kernel(
+            kernel_input(pose),
+            kernel_input(reference),
+            kernel_input(params),
+            *self._ik_limits,
+            flags,
+            rows,
+            scalars,
+        )
         residual, status, miss, deviation, selected = scalars.tolist()
         if int(status) == ik.IkStatus.NOT_RIGID and np.abs(pose[3] - _BOTTOM_ROW).max() > 1e-9:
             raise NotRigidTransformError(

@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan.collision import _kernels
 from lynxplan.collision.obstacles import (
     Obstacle,
@@ -164,7 +165,7 @@ class CollisionWorld:
         """World poses of every primitive. q: (nq,) or (N, nq) in [rad] -> (N, G, 4, 4), [m]."""
         config = _configurations(q, self.model.nq)
         poses = np.empty((len(config), len(self.links), 4, 4))
-        _kernels.poses_kernel(config, *self._kernel_joints, poses)
+        _kernels.poses_kernel(kernel_input(config), *self._kernel_joints, poses)
         return poses
 
     # -- distances ----------------------------------------------------------------------------

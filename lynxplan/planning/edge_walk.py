@@ -197,7 +197,7 @@ def edge_fraction(
 
     Returns -1 if q_a itself is not valid (:func:`edge_walk`).
     """
-    return edge_walk(q_a, q_b, model, scratch, clearance, False, 0)
+    return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0))
 
 
 @numba.njit(cache=True)
@@ -219,7 +219,7 @@ def edge_fraction_from(
     scratch[4][:] = slack_a
     scratch[19][:] = slack_b
     grid = END_KNOWN | (MIDPOINT if midpoint else 0)
-    return edge_walk(q_a, q_b, model, scratch, clearance, True, grid)
+    return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(True), grid)
 
 
 @numba.njit(cache=True)
@@ -229,7 +229,8 @@ def edge_is_free_after_midpoint(
     """:func:`edge_is_free` right after a quick test of its midpoint passed
     (:func:`lynxplan.planning.validity.point_is_clear` at s = 0.5: its bounds are in
     scratch[18])."""
-    return edge_walk(q_a, q_b, model, scratch, clearance, False, MIDPOINT) >= 1.0
+    walked = edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(MIDPOINT))
+    return walked >= 1.0
 
 
 #: Flags of :func:`edge_walk`: the pairs' slacks at the edge's end are in scratch[19]; their
@@ -456,6 +457,9 @@ def edge_walk(
     walk stops at the first point where a pair's slack is within :data:`STALL_DISTANCE`
     (returned), or when every pair is certified to s = 1. Returns -1 if q_a itself is not
     valid. Proof: module docstring.
+
+    Callers pass ``known`` and ``grid`` as ``np.bool_``/``np.int64``: numba compiles a function
+    once per literal argument value, and this walk takes about a minute to compile.
     """
     count = model[8].shape[0]
     counters, slack = scratch[9], scratch[4]
@@ -513,4 +517,4 @@ def edge_is_free(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
     """Whether the whole edge from q_a to q_b is certified (:func:`edge_fraction`)."""
-    return edge_walk(q_a, q_b, model, scratch, clearance, False, 0) >= 1.0
+    return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0)) >= 1.0

@@ -178,7 +178,7 @@ def _extends(
         return False
     start = _slacks(nodes, slacks, known, tree, near, model, scratch, clearance)
     reached = edge_fraction_from(
-        nodes[tree, near], new, start, fresh, True, model, scratch, clearance
+        nodes[tree, near], new, start, fresh, np.bool_(True), model, scratch, clearance
     )
     return bool(reached >= 1.0)
 
@@ -218,7 +218,9 @@ def _connect(
     target = base + fraction * (new - base)
     for p in range(ahead.shape[1]):
         ahead[1, p] = ahead[0, p] - clearance
-    reached = edge_fraction_from(base, target, start, ahead[1], False, model, scratch, clearance)
+    reached = edge_fraction_from(
+        base, target, start, ahead[1], np.bool_(False), model, scratch, clearance
+    )
     return fraction * reached if reached < 1.0 else fraction
 
 

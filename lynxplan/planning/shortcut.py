@@ -117,7 +117,7 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
                 start = _slacks_at(path, i, slacks, known, model, scratch, clearance)
                 end = _slacks_at(path, j, slacks, known, model, scratch, clearance)
                 reached = edge_fraction_from(
-                    path[i], path[j], start, end, True, model, scratch, clearance
+                    path[i], path[j], start, end, np.bool_(True), model, scratch, clearance
                 )
                 if reached >= 1.0:
                     break
@@ -149,7 +149,7 @@ def _segments_free(
         end = _slacks_at(points, k + 1, slacks, known, model, scratch, clearance)
         scratch[18][:] = middle[k]
         reached = edge_fraction_from(
-            points[k], points[k + 1], start, end, True, model, scratch, clearance
+            points[k], points[k + 1], start, end, np.bool_(True), model, scratch, clearance
         )
         if reached < 1.0:
             return False

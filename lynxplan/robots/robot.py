@@ -23,6 +23,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan.arm.geometry import JointLimits
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import ShapeError, TargetError
@@ -179,7 +180,9 @@ class Robot:
             out = np.asarray(self._arm.fk(configs))
         else:
             out = np.empty((configs.shape[0], 4, 4))
-            _chain.chain_fk_batch(self.chain.placements, self.chain.axes, configs, out)
+            _chain.chain_fk_batch(
+                self.chain.placements, self.chain.axes, kernel_input(configs), out
+            )
         return out[0] if np.ndim(q) == 1 else out
 
     def jacobian(self, q: Any) -> np.ndarray:

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
@@ -201,11 +202,11 @@ def _kernel(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlot
         family.packed,
         robot.chain.placements,
         robot.chain.axes,
-        target.poses,
+        kernel_input(target.poses),
         target.kind,
-        target.pitch,
-        target.roll,
-        reference,
+        kernel_input(target.pitch),
+        kernel_input(target.roll),
+        kernel_input(reference),
         *out,
         miss,
     )
@@ -225,7 +226,15 @@ def solve_pose_one(
     slots = 4 if family.tool_on_roll_axis else 4 * fk_.MAX_ROOTS
     table = np.empty((slots, _pk.SLOT_COLUMNS))
     chain = robot.chain
-    count = _pk.pose_one(family.packed, chain.placements, chain.axes, pose, reference, slots, table)
+    count = _pk.pose_one(
+        family.packed,
+        chain.placements,
+        chain.axes,
+        kernel_input(pose),
+        kernel_input(reference),
+        slots,
+        table,
+    )
     if count == 0:
         return None
     q = table[:count, :5].copy()
@@ -258,8 +267,8 @@ def _pose_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchS
         family.packed,
         robot.chain.placements,
         robot.chain.axes,
-        target.poses,
-        reference,
+        kernel_input(target.poses),
+        kernel_input(reference),
         *out,
         solved,
     )
