@@ -45,7 +45,7 @@ from lynxplan.planning.edge_walk import (
     reach_step,
     span_motion,
 )
-from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE
+from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE, njit_no_refcount
 from lynxplan.planning.lanes import (
     MAX_JOINTS,
     OUT_ARMS,
@@ -149,7 +149,7 @@ def segment_rates(path: np.ndarray, model: Any) -> np.ndarray:
     return out
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _end_bounds(
     q_a: np.ndarray, q_b: np.ndarray, end: float, model: Any, scratch: Any, out: np.ndarray
 ) -> None:
@@ -160,7 +160,7 @@ def _end_bounds(
     all_pair_bounds(model, scratch[3], out[1])
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _sphere_chain(
     q_a: np.ndarray, q_b: np.ndarray, p: int, gap: float, model: Any, scratch: Any
 ) -> bool:
@@ -202,7 +202,7 @@ def _sphere_chain(
     return s + one >= 1.0  # certified one-sided from the last point to the end
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _sphere_grid(
     q_a: np.ndarray,
     q_b: np.ndarray,
@@ -244,7 +244,7 @@ def _sphere_grid(
             todo[p] = False
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _chain(
     q_a: np.ndarray,
     q_b: np.ndarray,

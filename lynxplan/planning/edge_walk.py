@@ -36,7 +36,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from lynxplan.planning.kernel_model import LANES
+from lynxplan.planning.kernel_model import LANES, njit_no_refcount
 from lynxplan.planning.lanes import (
     MAX_JOINTS,
     OUT_ARMS,
@@ -175,7 +175,7 @@ LANE_GROWTH = 1.2
 LANE_FLOOR = 0.05
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def state_slacks(
     q: np.ndarray, model: Any, scratch: Any, clearance: float, out: np.ndarray
 ) -> bool:
@@ -189,7 +189,7 @@ def state_slacks(
     return True
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def edge_fraction(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> float:
@@ -200,13 +200,13 @@ def edge_fraction(
     return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0))
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def edge_fraction_from(
     q_a: np.ndarray,
     q_b: np.ndarray,
     slack_a: np.ndarray,
     slack_b: np.ndarray,
-    midpoint: bool,
+    midpoint: bool | np.bool_,
     model: Any,
     scratch: Any,
     clearance: float,
@@ -216,13 +216,15 @@ def edge_fraction_from(
     computed once); with ``midpoint``, scratch[18] holds every pair's bound at the edge's
     midpoint (a quick test :func:`lynxplan.planning.validity.point_is_clear` at s = 0.5 of
     this edge that passed, just before)."""
-    scratch[4][:] = slack_a
-    scratch[19][:] = slack_b
+    start, end = scratch[4], scratch[19]
+    for p in range(start.shape[0]):
+        start[p] = slack_a[p]
+        end[p] = slack_b[p]
     grid = END_KNOWN | (MIDPOINT if midpoint else 0)
     return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(True), grid)
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def edge_is_free_after_midpoint(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
@@ -245,7 +247,7 @@ def _walk_start(
     model: Any,
     scratch: Any,
     clearance: float,
-    known: bool,
+    known: bool | np.bool_,
     grid: int,
 ) -> bool:
     """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and at
@@ -434,14 +436,14 @@ def _lane_run(
     return 1.0
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def edge_walk(
     q_a: np.ndarray,
     q_b: np.ndarray,
     model: Any,
     scratch: Any,
     clearance: float,
-    known: bool,
+    known: bool | np.bool_,
     grid: int,
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
@@ -512,7 +514,7 @@ def edge_walk(
         reach[p] = nearest + reach_step(slack_t, p, all_arms, p, model, scratch)
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def edge_is_free(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:

@@ -31,7 +31,7 @@ import numba
 import numpy as np
 
 from lynxplan._fastmath import sincos
-from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE
+from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE, njit_no_refcount, stack_array
 
 #: Joints (frames) a kernel model may have for the lanes (the scalar walk serves larger ones).
 MAX_JOINTS = 12
@@ -52,6 +52,8 @@ _S = _B + 12
 _T = _S + 1
 _BOUND = _T + 1
 _ROWS = _BOUND + 1
+#: The work rows of :func:`pair_along`, on its stack.
+_lane_rows = stack_array(_ROWS, LANES)
 #: Rows of the output of :func:`pair_along`: 0 the bound [m], 1 the parameter s (input), 2 the
 #: bounding-sphere gap of the exact verification [m], 3 + j the lever arm about configuration
 #: index j [m].
@@ -289,7 +291,7 @@ def _arm_rows(w: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
             out[OUT_ARMS + j, i] = w[_T, i]
 
 
-@numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
+@njit_no_refcount(error_model="numpy", fastmath=_FAST)
 def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
     """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
     [rad]: out[OUT_BOUND] its distance lower bound [m], out[OUT_ARMS + j] its lever arm about
@@ -299,7 +301,7 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
     The model must satisfy :func:`lanes_supported`.
     """
     pairs, prim_joints = model[8], model[4]
-    w = np.empty((_ROWS, LANES))
+    w = _lane_rows()
     for i in range(LANES):
         w[_S, i] = out[OUT_S, i]
     for r in range(12):  # the universe frame: identity
@@ -374,6 +376,8 @@ PAIR_BLOCK = 64
 _HA, _HB = 24, 27
 _RAB, _SPHERE, _SR = 30, 31, 32
 _PAIR_ROWS = 33
+#: The work rows of :func:`all_pair_bounds`, on its stack.
+_pair_rows = stack_array(_PAIR_ROWS, PAIR_BLOCK)
 
 
 @numba.njit(cache=True, inline="always")
@@ -384,7 +388,7 @@ def _gather_pose(w: np.ndarray, row: int, i: int, poses: np.ndarray, g: int) -> 
         w[row + 9 + r, i] = poses[g, r, 3]
 
 
-@numba.njit(cache=True, error_model="numpy", fastmath=_FAST)
+@njit_no_refcount(error_model="numpy", fastmath=_FAST)
 def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
     """Lower bound of every pair's distance at primitive poses (G, 4, 4) -> out (P,), in [m].
 
@@ -395,7 +399,7 @@ def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
     pairs, half, radius = model[8], model[6], model[7]
     kinds, obstacle_poses = model[10], model[12]
     obstacle_half, obstacle_radius = model[13], model[14]
-    w = np.empty((_PAIR_ROWS, PAIR_BLOCK))
+    w = _pair_rows()
     count = pairs.shape[0]
     for start in range(0, count, PAIR_BLOCK):
         m = min(PAIR_BLOCK, count - start)

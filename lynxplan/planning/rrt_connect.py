@@ -41,6 +41,7 @@ from lynxplan.planning.edge_walk import (
     edge_is_free_after_midpoint,
     state_slacks,
 )
+from lynxplan.planning.kernel_model import njit_no_refcount
 from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
 
 #: Kernel status codes.
@@ -86,7 +87,7 @@ class RrtConnectResult:
     elapsed: float
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _nearest(nodes: np.ndarray, count: int, q: np.ndarray) -> int:
     best, best_index = np.inf, 0
     nq = q.shape[0]
@@ -311,7 +312,7 @@ def rrt_connect_kernel(
     return RUNNING
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def straight_goal(
     start: np.ndarray, goals: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> int:

@@ -37,7 +37,12 @@ import numba
 import numpy as np
 
 from lynxplan.planning import rng as _rng
-from lynxplan.planning.edge_walk import edge_fraction_from, edge_is_free_after_midpoint
+from lynxplan.planning.edge_walk import (
+    copy_row,
+    edge_fraction_from,
+    edge_is_free_after_midpoint,
+)
+from lynxplan.planning.kernel_model import njit_no_refcount
 from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
 
 #: Shortcut attempts by default.
@@ -56,7 +61,7 @@ FLATTEN_LEVELS = 1
 _MERGE_DISTANCE = 1e-9
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _point_at(
     path: np.ndarray, cumulative: np.ndarray, count: int, u: float, out: np.ndarray
 ) -> int:
@@ -72,7 +77,7 @@ def _point_at(
     return segment
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _distance(a: np.ndarray, b: np.ndarray) -> float:
     total = 0.0
     for j in range(a.shape[0]):
@@ -156,7 +161,7 @@ def _segments_free(
     return True
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _splice(
     path: np.ndarray,
     count: int,
@@ -171,22 +176,22 @@ def _splice(
     is left out. Returns the new count."""
     total = 0
     for k in range(i1 + 1):
-        work[total] = path[k]
+        copy_row(work, total, path, k)
         total += 1
     start = 0 if _distance(points[0], path[i1]) > _MERGE_DISTANCE else 1
     stop = size if _distance(points[size - 1], path[i2 + 1]) > _MERGE_DISTANCE else size - 1
     for k in range(start, stop):
-        work[total] = points[k]
+        copy_row(work, total, points, k)
         total += 1
     for k in range(i2 + 1, count):
-        work[total] = path[k]
+        copy_row(work, total, path, k)
         total += 1
     for k in range(total):
-        path[k] = work[k]
+        copy_row(path, k, work, k)
     return total
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _full(
     path: np.ndarray,
     count: int,

@@ -43,6 +43,7 @@ from lynxplan.planning.kernel_model import (
     OBSTACLE_SPHERE,
     kernel_model,
     make_scratch,
+    njit_no_refcount,
     planner_pairs,
 )
 from lynxplan.planning.lanes import all_pair_bounds
@@ -167,7 +168,7 @@ def primitive_pose(g: int, model: Any, scratch: Any) -> None:
     _compose_into(scratch[0], model[4][g], model[5], g, scratch[3], g)
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
     """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
     joint_poses(q, model, scratch)
@@ -175,7 +176,7 @@ def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
         primitive_pose(g, model, scratch)
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def _separating_axis_gap(
     pa: np.ndarray,
     ia: int,
@@ -295,7 +296,7 @@ def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
     return float(gap)
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> None:
     """Lower bound of the distance of every pair at q (nq,) -> out (P,), in [m] (all pairs at
     once: :func:`lynxplan.planning.lanes.all_pair_bounds`)."""
@@ -303,7 +304,7 @@ def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> No
     all_pair_bounds(model, scratch[3], out)
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
     """Smallest pair bound at q (nq,), in [m] (inf without pairs)."""
     bounds = scratch[18]
@@ -314,7 +315,7 @@ def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
     return best
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: np.ndarray) -> int:
     """Every pair's bound at q (nq,) -> out (P,), in [m], and the first pair whose bound is at
     most ``threshold`` [m] (-1: none). The pair that failed last (scratch[9][3]) is tried
@@ -332,7 +333,7 @@ def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: 
     return -1
 
 
-@numba.njit(cache=True)
+@njit_no_refcount()
 def point_is_clear(
     q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any, clearance: float
 ) -> bool:
