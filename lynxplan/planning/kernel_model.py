@@ -35,13 +35,29 @@ def njit_no_refcount(**options: Any) -> Callable[[_Kernel], _Kernel]:
 
     Such a kernel allocates no array (its work arrays come in the scratch tuple or lie on its
     stack, :func:`stack_array`), returns none and copies arrays element by element: every array
-    it touches belongs to its caller or to its stack. It
-    calls only kernels compiled the same way or inlined ones (numba compiles a callee that sets
-    no ``_nrt`` with its caller's setting). With reference counting, each call took and dropped
+    it touches belongs to its caller or to its stack. It calls only kernels compiled the same
+    way, inlined ones or :func:`njit_refcounted` ones (numba compiles a callee that sets no
+    ``_nrt`` with its caller's setting). With reference counting, each call took and dropped
     an atomic reference per array of the model and scratch tuples (about 40) and per view taken
     inside: a fifth of the planning time.
     """
     settings: dict[str, Any] = {"cache": True, "_nrt": False, **options}
+
+    def compile_lazily(function: _Kernel) -> _Kernel:
+        return cast(_Kernel, numba.njit(**settings)(function))
+
+    return compile_lazily
+
+
+#: Alignment of a :func:`stack_array`, in bytes (a cache line: whole-register loads and stores).
+_STACK_ALIGNMENT = 64
+
+
+def njit_refcounted(**options: Any) -> Callable[[_Kernel], _Kernel]:
+    """``numba.njit(cache=True, **options)`` with numba's reference counting set explicitly
+    (``_nrt=True``): a kernel that allocates, called from :func:`njit_no_refcount` kernels (a
+    callee that sets no ``_nrt`` would be compiled without it, and fail to allocate)."""
+    settings: dict[str, Any] = {"cache": True, "_nrt": True, **options}
 
     def compile_lazily(function: _Kernel) -> _Kernel:
         return cast(_Kernel, numba.njit(**settings)(function))
@@ -68,6 +84,7 @@ def stack_array(rows: int, columns: int) -> Any:
             intp = context.get_value_type(types.intp)
             with builder.goto_entry_block():  # one stack slot per call of the kernel
                 data = builder.alloca(double, size=intp(rows * columns))
+                data.align = _STACK_ALIGNMENT
             context.populate_array(
                 array,
                 data=data,

@@ -31,7 +31,13 @@ import numba
 import numpy as np
 
 from lynxplan._fastmath import sincos
-from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE, njit_no_refcount, stack_array
+from lynxplan.planning.kernel_model import (
+    LANES,
+    OBSTACLE_SPHERE,
+    njit_no_refcount,
+    njit_refcounted,
+    stack_array,
+)
 
 #: Joints (frames) a kernel model may have for the lanes (the scalar walk serves larger ones).
 MAX_JOINTS = 12
@@ -376,8 +382,6 @@ PAIR_BLOCK = 64
 _HA, _HB = 24, 27
 _RAB, _SPHERE, _SR = 30, 31, 32
 _PAIR_ROWS = 33
-#: The work rows of :func:`all_pair_bounds`, on its stack.
-_pair_rows = stack_array(_PAIR_ROWS, PAIR_BLOCK)
 
 
 @numba.njit(cache=True, inline="always")
@@ -388,7 +392,7 @@ def _gather_pose(w: np.ndarray, row: int, i: int, poses: np.ndarray, g: int) -> 
         w[row + 9 + r, i] = poses[g, r, 3]
 
 
-@njit_no_refcount(error_model="numpy", fastmath=_FAST)
+@njit_refcounted(error_model="numpy", fastmath=_FAST)
 def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
     """Lower bound of every pair's distance at primitive poses (G, 4, 4) -> out (P,), in [m].
 
@@ -399,7 +403,8 @@ def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
     pairs, half, radius = model[8], model[6], model[7]
     kinds, obstacle_poses = model[10], model[12]
     obstacle_half, obstacle_radius = model[13], model[14]
-    w = _pair_rows()
+    # On the heap: measured a quarter faster than the same rows on the stack (stack_array).
+    w = np.empty((_PAIR_ROWS, PAIR_BLOCK))
     count = pairs.shape[0]
     for start in range(0, count, PAIR_BLOCK):
         m = min(PAIR_BLOCK, count - start)
