@@ -206,7 +206,7 @@ def edge_fraction_from(
     q_b: np.ndarray,
     slack_a: np.ndarray,
     slack_b: np.ndarray,
-    midpoint: bool,
+    midpoint: bool | np.bool_,
     model: Any,
     scratch: Any,
     clearance: float,
@@ -245,7 +245,7 @@ def _walk_start(
     model: Any,
     scratch: Any,
     clearance: float,
-    known: bool,
+    known: bool | np.bool_,
     grid: int,
 ) -> bool:
     """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and at
@@ -441,7 +441,7 @@ def edge_walk(
     model: Any,
     scratch: Any,
     clearance: float,
-    known: bool,
+    known: bool | np.bool_,
     grid: int,
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with

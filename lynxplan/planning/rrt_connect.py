@@ -34,6 +34,7 @@ from typing import Any, NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._jit import compile_before_timing
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
@@ -410,6 +411,29 @@ def rrt_connect(
     state = _rng.seed_state(seed)
     meta = np.array([0, -1, -1, 0], dtype=np.int64)
     model, scratch, clearance = checker.model, checker.scratch, checker.clearance
+    # the first call in a process: compile (or load) the kernel outside the time limit
+    began += compile_before_timing(
+        rrt_connect_kernel,
+        (
+            lower,
+            upper,
+            settings.step,
+            settings.goal_bias,
+            model,
+            scratch,
+            clearance,
+            nodes,
+            parents,
+            counts,
+            roots,
+            state,
+            meta,
+            CHUNK_ITERATIONS,
+            slacks,
+            known,
+        ),
+        "the planner",
+    )
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.vstack([start, goals[k]])
