@@ -36,6 +36,7 @@ def kernel_input(array: np.ndarray) -> np.ndarray:
     costs seconds to tens of seconds of compile on first use). The kernels do not write their
     inputs.
     """
-    if array.flags.c_contiguous and array.flags.writeable:
+    flags = array.flags
+    if flags.c_contiguous and flags.writeable:
         return array
     return np.array(array, order="C")

@@ -68,8 +68,8 @@ def _ik() -> ModuleType:
     return _IK_MODULE
 
 
+# The default IK reference, writable like every kernel input (kernel_input); never written.
 _ZEROS = np.zeros(5)
-_ZEROS.setflags(write=False)
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
