@@ -27,12 +27,16 @@ def as_rows(values: Any, width: int, name: str) -> np.ndarray:
 
 
 def kernel_input(array: np.ndarray) -> np.ndarray:
-    """A read-only, C-contiguous view of a kernel's input array (a copy only when not contiguous).
+    """A kernel's input as a writable C-contiguous array: the array itself when it is one, a copy
+    otherwise (a read-only or strided array).
 
     numba compiles a kernel once per argument type, and a read-only array, a writable one and a
-    non-contiguous one are three types: passing every input through this keeps one compiled
-    signature per kernel (each costs seconds to tens of seconds of compile on first use).
+    non-contiguous one are three types. The kernels build their own work arrays writable, so
+    passing every input from Python writable too keeps one compiled signature per kernel (each
+    costs seconds to tens of seconds of compile on first use). The kernels do not write their
+    inputs.
     """
-    view = np.ascontiguousarray(array).view()
-    view.setflags(write=False)
-    return view
+    flags = array.flags
+    if flags.c_contiguous and flags.writeable:
+        return array
+    return np.array(array, order="C")

@@ -10,6 +10,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan._fastmath import sincos
 from lynxplan.arm.closed_form import tool_pose_from_sines
 from lynxplan.arm.configuration import as_configurations
@@ -98,9 +99,7 @@ def forward_kinematics(
         out = np.empty(shape)
     elif out.shape != shape or out.dtype != np.float64 or not out.flags.c_contiguous:
         raise ShapeError("out", f"{shape}, float64, C-contiguous", out.shape)
-    if not batch.flags.writeable:  # the IK kernels call it with writable rows: one signature
-        batch = batch.copy()
-    fk_kernel(batch, geometry.a2, geometry.a3, geometry.d5, out)
+    fk_kernel(kernel_input(batch), geometry.a2, geometry.a3, geometry.d5, out)
     return out[0] if np.ndim(q) == 1 else out
 
 

@@ -68,8 +68,8 @@ def _ik() -> ModuleType:
     return _IK_MODULE
 
 
+# The default IK reference, writable like every kernel input (kernel_input); never written.
 _ZEROS = np.zeros(5)
-_ZEROS.setflags(write=False)
 _BOTTOM_ROW = np.array([0.0, 0.0, 0.0, 1.0])
 
 
@@ -104,9 +104,10 @@ class Arm:
         self.geometry = read_geometry(self.model)
         self.limits = read_limits(self.model)
         self.tool_frame_id = self.model.getFrameId(TOOL_FRAME)
-        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance; limits.
+        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance; limits
+        # (private writable copies: the kernel's one compiled signature, see kernel_input).
         g = self.geometry
-        self._ik_params = kernel_input(np.array([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE]))
+        self._ik_params = np.array([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE])
         self._ik_limits = kernel_input(self.limits.lower), kernel_input(self.limits.upper)
 
     # -- geometry models (collision and visual), built on first use ------------------------------
@@ -262,7 +263,7 @@ class Arm:
         ik.ik_single_kernel(
             kernel_input(pose),
             kernel_input(reference),
-            kernel_input(params),
+            params,
             *self._ik_limits,
             flags,
             rows,

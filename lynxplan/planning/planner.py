@@ -14,11 +14,17 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan._jit import compile_notice
 from lynxplan.collision import CollisionWorld, Obstacle
 from lynxplan.exceptions import InputError, PlanningFailed, StateInCollisionError
+from lynxplan.planning.certify import schedule
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
-from lynxplan.planning.shortcut import DEFAULT_SHORTCUT_ITERATIONS, shortcut_to_goals
+from lynxplan.planning.shortcut import (
+    DEFAULT_SHORTCUT_ITERATIONS,
+    shortcut_kernel,
+    shortcut_to_goals,
+)
 from lynxplan.planning.space import JointSpace
 from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE, METHODS, TimedPath, time_parameterize
 from lynxplan.planning.validity import STALL_DISTANCE, ValidityChecker
@@ -201,6 +207,20 @@ class Planner:
                 f"{(self.options.clearance + STALL_DISTANCE) * 1e3:.2f} mm",
             )
 
+    def _compile(self, q: np.ndarray) -> None:
+        """On the first query in a process, compile (or load from numba's cache) the shortcut
+        and verification kernels before the clock starts, on a path that stays at q (nq,), a
+        valid configuration: their run is trivial, their compile is not. (RRT-Connect compiles
+        its own kernel outside its time limit.)"""
+        if shortcut_kernel.signatures and schedule.signatures:
+            return
+        path = np.vstack([q, q])
+        with compile_notice("the planner"):
+            shortcut_to_goals(
+                self.checker, path, path[1:], 0, self.space.lower, self.space.upper, seed=0
+            )
+            self.verifier.verify(path, self.options.clearance)
+
     def _check_state(self, q: np.ndarray, what: str) -> None:
         require_clear(self.world, q, what, self.options.clearance)
 
@@ -231,6 +251,7 @@ class Planner:
         if not certifiable:
             self._require_certifiable(goals.configurations[free[0]], "goal")
         free = certifiable
+        self._compile(q_start)
         began = time.perf_counter()
         settings = RrtConnectSettings(
             self.options.step, self.options.goal_bias, self.options.max_nodes
@@ -246,6 +267,7 @@ class Planner:
             settings=settings,
         )
         planned = time.perf_counter()
+        began = planned - found.elapsed  # without compiling its kernel (first call in a process)
         path, reached = shortcut_to_goals(
             self.checker,
             found.path,

@@ -34,6 +34,7 @@ from typing import Any, NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._jit import compile_before_timing
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
@@ -401,7 +402,7 @@ def rrt_connect(
         2 + math.ceil(float(np.linalg.norm(upper - lower)) / settings.step)
     )
     trees = _Trees.empty(min(limit, INITIAL_CAPACITY), nq, len(checker.pair_names))
-    nodes, parents, slacks, known = trees
+    nodes, parents = trees.nodes, trees.parents
     parents[0, 0] = -1
     parents[1, : len(goals)] = -1
     counts = np.array([1, len(goals)], dtype=np.int64)
@@ -411,6 +412,14 @@ def rrt_connect(
     state = _rng.seed_state(seed)
     meta = np.array([0, -1, -1, 0], dtype=np.int64)
     model, scratch, clearance = checker.model, checker.scratch, checker.clearance
+    fixed = (lower, upper, settings.step, settings.goal_bias, model, scratch, clearance)
+
+    def arguments(trees: _Trees) -> tuple[Any, ...]:
+        nodes, parents, slacks, known = trees
+        return (*fixed, nodes, parents, counts, roots, state, meta, CHUNK_ITERATIONS, slacks, known)
+
+    # the first call in a process: compile (or load) the kernel outside the time limit
+    began += compile_before_timing(rrt_connect_kernel, arguments(trees), "the planner")
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.vstack([start, goals[k]])
@@ -419,31 +428,14 @@ def rrt_connect(
         capacity = nodes.shape[1]
         if capacity < limit and int(counts.max()) + per_call >= capacity:
             trees = trees.grown(min(limit, max(2 * capacity, int(counts.max()) + per_call + 1)))
-            nodes, parents, slacks, known = trees
-        status = rrt_connect_kernel(
-            lower,
-            upper,
-            settings.step,
-            settings.goal_bias,
-            model,
-            scratch,
-            clearance,
-            nodes,
-            parents,
-            counts,
-            roots,
-            state,
-            meta,
-            CHUNK_ITERATIONS,
-            slacks,
-            known,
-        )
+            nodes, parents = trees.nodes, trees.parents
+        status = rrt_connect_kernel(*arguments(trees))
         elapsed = time.perf_counter() - began
         if status == SOLVED:
             break
         if status == NODE_LIMIT and nodes.shape[1] < limit:  # not the budget: grow, go on
             trees = trees.grown(min(limit, 2 * nodes.shape[1]))
-            nodes, parents, slacks, known = trees
+            nodes, parents = trees.nodes, trees.parents
             continue
         if status == NODE_LIMIT:
             raise PlanningFailed(

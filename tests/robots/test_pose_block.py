@@ -15,6 +15,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lynxplan._arrays import kernel_input
 from lynxplan.robots import Robot, load_robot
 from lynxplan.robots.ik import pose_kernel
 from lynxplan.robots.ik.pose_block import pose_block_kernel, smallest_errors
@@ -32,7 +33,15 @@ def _both(robot: Robot, poses: np.ndarray, reference: np.ndarray) -> tuple[tuple
     for kernel in (pose_kernel.pose_kernel, pose_block_kernel):
         out = BranchSlots.empty(len(poses), slots)
         solved = np.empty(len(poses), dtype=np.bool_)
-        count = kernel(family.packed, chain.placements, chain.axes, poses, reference, *out, solved)
+        count = kernel(
+            family.packed,
+            chain.placements,
+            chain.axes,
+            kernel_input(poses),
+            kernel_input(reference),
+            *out,
+            solved,
+        )
         fallbacks = count if count is not None else fallbacks
         results.append((*out, solved))
     return results[0], results[1], fallbacks

@@ -1,0 +1,81 @@
+"""Each big numba kernel compiles once: the library passes it one argument type whatever the
+caller passes (read-only or writable arrays, literal flags).
+
+numba compiles a kernel once per argument type (a read-only array, a literal ``True`` and a
+``bool`` are different types); each extra version of the planner's edge walk or of the IK
+kernels costs tens of seconds of compile on first use. The workload runs in a fresh process,
+which loads the kernels from numba's cache for exactly the types it calls them with.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+WORKLOAD = """
+import json
+import numpy as np
+import lynxplan
+from lynxplan.arm import Arm
+from lynxplan.arm.ik import solve_ik_batch
+from lynxplan.arm import ik_kernel, ik_select
+from lynxplan.planning import certify, rrt_connect, shortcut
+from lynxplan.robots.ik import family_kernel, pose_block, pose_kernel
+
+for name in ("p02_box_between", "p05_goal_behind_wall"):
+    lynxplan.run_scenario(f"scenarios/planning/{name}.yaml", None, quick=True)
+
+arm = Arm()
+q = np.radians([30, 60, -45, 45, 10])
+T = arm.fk(q)
+T.setflags(write=False)  # the library's results are read-only
+arm.ik(T)
+arm.ik(arm.fk(q), q_reference=q, limit_tolerance=0.0)
+batch = np.stack([T, T])
+solve_ik_batch(batch)
+batch.setflags(write=False)
+solve_ik_batch(batch)
+solve_ik_batch(np.stack([T, T]), q_reference=q, limit_tolerance=0.0)
+
+robot = lynxplan.load_robot("so101")
+rng = np.random.default_rng(1)
+qs = rng.uniform(robot.limits.lower, robot.limits.upper, size=(300, 5))
+poses = robot.fk(qs)
+poses.setflags(write=False)
+robot.ik(poses[0])
+robot.ik_batch(poses)
+robot.ik_batch(poses[:10])
+robot.ik(position=poses[0, :3, 3], approach=poses[0, :3, 2])
+
+kernels = {
+    "rrt_connect_kernel": rrt_connect.rrt_connect_kernel,
+    "shortcut_kernel": shortcut.shortcut_kernel,
+    "schedule": certify.schedule,
+    "ik_kernel": ik_kernel.ik_kernel,
+    "ik_single_kernel": ik_select.ik_single_kernel,
+    "family_ik_kernel": family_kernel.family_ik_kernel,
+    "pose_kernel": pose_kernel.pose_kernel,
+    "pose_block_kernel": pose_block.pose_block_kernel,
+}
+print(json.dumps({name: len(k.signatures) for name, k in kernels.items()}))
+"""
+
+
+def test_each_big_kernel_has_one_compiled_signature() -> None:
+    done = subprocess.run(
+        [sys.executable, "-c", WORKLOAD],
+        cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=900,
+        check=False,
+    )
+    assert done.returncode == 0, done.stderr[-3000:]
+    counts = json.loads(done.stdout.strip().splitlines()[-1])
+    assert all(count <= 1 for count in counts.values()), counts
+    for name in ("rrt_connect_kernel", "shortcut_kernel", "ik_kernel", "ik_single_kernel"):
+        assert counts[name] == 1, counts  # used by the workload
