@@ -55,8 +55,9 @@ _STACK_ALIGNMENT = 64
 
 def njit_refcounted(**options: Any) -> Callable[[_Kernel], _Kernel]:
     """``numba.njit(cache=True, **options)`` with numba's reference counting set explicitly
-    (``_nrt=True``): a kernel that allocates, called from :func:`njit_no_refcount` kernels (a
-    callee that sets no ``_nrt`` would be compiled without it, and fail to allocate)."""
+    (``_nrt=True``): a kernel that allocates or returns an array, and may be called from
+    :func:`njit_no_refcount` kernels (a callee that sets no ``_nrt`` is compiled with its first
+    caller's setting: it would fail to allocate, or return a view without its reference)."""
     settings: dict[str, Any] = {"cache": True, "_nrt": True, **options}
 
     def compile_lazily(function: _Kernel) -> _Kernel:

@@ -42,7 +42,7 @@ from lynxplan.planning.edge_walk import (
     edge_is_free_after_midpoint,
     state_slacks,
 )
-from lynxplan.planning.kernel_model import njit_no_refcount
+from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
 from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
 
 #: Kernel status codes.
@@ -137,7 +137,7 @@ def _sample(
             out[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
 
 
-@numba.njit(cache=True)
+@njit_refcounted()  # returns a view: counted even when called from an uncounted kernel
 def _slacks(
     nodes: np.ndarray,
     slacks: np.ndarray,

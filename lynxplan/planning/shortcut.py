@@ -42,7 +42,7 @@ from lynxplan.planning.edge_walk import (
     edge_fraction_from,
     edge_is_free_after_midpoint,
 )
-from lynxplan.planning.kernel_model import njit_no_refcount
+from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
 from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
 
 #: Shortcut attempts by default.
@@ -85,7 +85,7 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
     return float(np.sqrt(total))
 
 
-@numba.njit(cache=True)
+@njit_refcounted()  # returns a view: counted even when called from an uncounted kernel
 def _slacks_at(
     points: np.ndarray,
     k: int,
