@@ -418,7 +418,7 @@ def rrt_connect(
         return (*fixed, nodes, parents, counts, roots, state, meta, CHUNK_ITERATIONS, slacks, known)
 
     # the first call in a process: compile (or load) the kernel outside the time limit
-    began += compile_before_timing(rrt_connect_kernel, arguments(trees), "the planner")
+    began += compile_before_timing(rrt_connect_kernel, arguments(trees))
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.vstack([start, goals[k]])
