@@ -31,7 +31,7 @@ import warnings
 from collections.abc import Sequence
 from typing import Any
 
-from lynxplan import guards
+from lynxplan import _jit, guards
 from lynxplan.exceptions import LynxplanError, LynxplanInputError
 
 #: Negative numbers, including ``-inf`` and ``-nan`` (which the value checks then reject with a
@@ -211,6 +211,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if argv is not None:
         return _main(argv)
     argv = sys.argv[1:]
+    _jit.enable_notices()  # the process is the CLI: say so when numba compiles for long
     if _command(argv) not in LONG_RUNNING_COMMANDS:
         young, middle, old = gc.get_threshold()
         gc.set_threshold(max(young, GC_THRESHOLD), middle, old)

@@ -19,6 +19,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lynxplan import _jit
 from lynxplan._arrays import kernel_input
 from lynxplan.arm.geometry import ArmGeometry, JointLimits
 from lynxplan.arm.ik_kernel import (
@@ -69,6 +70,8 @@ class IkBatch(NamedTuple):
     deviation: np.ndarray
     """Deviation of each pose's rotation from orthonormal, ``max |R^T R - I|``, shape (N,)."""
 
+
+_jit.listen()  # the IK kernels: a notice when their first compile takes long
 
 _DEFAULT_GEOMETRY = ArmGeometry()
 _DEFAULT_LIMITS = JointLimits()

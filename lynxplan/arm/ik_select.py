@@ -93,15 +93,13 @@ def ik_single_kernel(
     T: np.ndarray,
     q_ref: np.ndarray,
     params: np.ndarray,
-    lower: np.ndarray,
-    upper: np.ndarray,
     flags: int,
     rows: np.ndarray,
     scalars: np.ndarray,
 ) -> None:
     """IK of one pose (4, 4), every branch checked by FK, and the selection, in one call.
 
-    ``params`` = (a2, a3, d5, limit_tol); ``lower``, ``upper``: the joint limits (5,), in [rad];
+    ``params`` = (a2, a3, d5, limit_tol, lower (5), upper (5)), lengths in [m], angles in [rad];
     ``flags`` bit 0 = approach only, bit 1 = report selection rule. Writes ``rows`` (4, 8): q
     (5), within, position error, orientation error per branch; ``scalars`` (5,): residual,
     status, miss, deviation, selected (-1 when no branch qualifies). Packed so the call boxes no
@@ -114,7 +112,8 @@ def ik_single_kernel(
     within = np.empty((1, 4), dtype=np.bool_)
     residual, status = np.empty(1), np.empty(1, dtype=np.int8)
     miss, deviation = np.empty(1), np.empty(1)
-    arm = IkParams(a2, a3, d5, lower, upper, params[3], approach_only)
+    # the limits as C arrays (copies): the same kernel types as the batch call from Python
+    arm = IkParams(a2, a3, d5, params[4:9].copy(), params[9:14].copy(), params[3], approach_only)
     out = IkOutputs(q, within, residual, status, miss, deviation)
     ik_kernel(T.reshape(1, 4, 4), q_ref.reshape(1, 5), arm, out)
     rows[:, :] = np.nan

@@ -104,11 +104,12 @@ class Arm:
         self.geometry = read_geometry(self.model)
         self.limits = read_limits(self.model)
         self.tool_frame_id = self.model.getFrameId(TOOL_FRAME)
-        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance; limits
-        # (private writable copies: the kernel's one compiled signature, see kernel_input).
+        # Packed parameters of the single-pose IK kernel: a2, a3, d5, snap tolerance, limits
+        # (writable, as every kernel input: one compiled signature, see kernel_input).
         g = self.geometry
-        self._ik_params = np.array([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE])
-        self._ik_limits = kernel_input(self.limits.lower), kernel_input(self.limits.upper)
+        self._ik_params = np.concatenate(
+            ([g.a2, g.a3, g.d5, LIMIT_SNAP_TOLERANCE], self.limits.lower, self.limits.upper)
+        )
 
     # -- geometry models (collision and visual), built on first use ------------------------------
     @cached_property
@@ -264,7 +265,6 @@ class Arm:
             kernel_input(pose),
             kernel_input(reference),
             params,
-            *self._ik_limits,
             flags,
             rows,
             scalars,

@@ -20,7 +20,6 @@ RATE = 1000.0
 
 def _loop_sample(plan: object) -> np.ndarray:
     """Per-sample Python loop producing the same samples as ``plan.sample(RATE)``."""
-    from lynxplan._arrays import kernel_input
     from lynxplan.arm.geometry import ArmGeometry
     from lynxplan.arm.ik import ik_single_kernel
     from lynxplan.arm.kinematics import fk_kernel
@@ -37,11 +36,10 @@ def _loop_sample(plan: object) -> np.ndarray:
     tool = np.empty((1, 4, 4))
     target = np.eye(4)
     out = np.empty((count, 5))
-    # Packed arguments of the single-pose kernel: (a2, a3, d5, limit_tol), lower, upper; read-only
-    # views, as the library passes them (one compiled signature).
-    params = kernel_input(np.array([geometry.a2, geometry.a3, geometry.d5, LIMIT_SNAP_TOLERANCE]))
-    limits = kernel_input(lower), kernel_input(upper)
-    target_in = kernel_input(target)
+    # Packed arguments of the single-pose kernel: (a2, a3, d5, limit_tol, lower, upper).
+    params = np.concatenate(
+        [[geometry.a2, geometry.a3, geometry.d5, LIMIT_SNAP_TOLERANCE], lower, upper]
+    )
     rows, scalars = np.empty((4, 8)), np.empty(5)
     index = 0
     previous = segments[0].q_start.copy()
@@ -64,8 +62,7 @@ def _loop_sample(plan: object) -> np.ndarray:
             )
             reference = previous.copy()
             reference[4] = seg.roll[0] + s * (seg.roll[1] - seg.roll[0])
-            reference_in = kernel_input(reference)  # flags 1: approach only
-            ik_single_kernel(target_in, reference_in, params, *limits, 1, rows, scalars)
+            ik_single_kernel(target, reference, params, 1, rows, scalars)  # 1: approach only
             q = rows[int(scalars[4]), :5].copy()
             first, second = seg.path_derivatives(s)
             qd, qdd = first * sd, first * sdd + second * sd * sd

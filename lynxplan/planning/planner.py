@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from lynxplan._jit import compile_notice
+from lynxplan import _jit
 from lynxplan.collision import CollisionWorld, Obstacle
 from lynxplan.exceptions import InputError, PlanningFailed, StateInCollisionError
 from lynxplan.planning.certify import schedule
@@ -30,6 +30,8 @@ from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE, METHODS, TimedPath, ti
 from lynxplan.planning.validity import STALL_DISTANCE, ValidityChecker
 from lynxplan.planning.verify import VerificationReport, require_clear, verifier_of
 from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK
+
+_jit.listen()  # the planner's kernels: a notice when their first compile takes long
 
 #: Default required clearance between the robot and anything else, in [m].
 DEFAULT_CLEARANCE = 0.002
@@ -212,14 +214,12 @@ class Planner:
         and verification kernels before the clock starts, on a path that stays at q (nq,), a
         valid configuration: their run is trivial, their compile is not. (RRT-Connect compiles
         its own kernel outside its time limit.)"""
-        if shortcut_kernel.overloads and schedule.overloads:  # (.signatures: 20 us each)
+        if shortcut_kernel.overloads and schedule.overloads:  # (.signatures: ~20 us each)
             return
         path = np.vstack([q, q])
-        with compile_notice("the planner"):
-            shortcut_to_goals(
-                self.checker, path, path[1:], 0, self.space.lower, self.space.upper, seed=0
-            )
-            self.verifier.verify(path, self.options.clearance)
+        lower, upper = self.space.lower, self.space.upper
+        shortcut_to_goals(self.checker, path, path[1:], 0, lower, upper, seed=0)
+        self.verifier.verify(path, self.options.clearance)
 
     def _check_state(self, q: np.ndarray, what: str) -> None:
         require_clear(self.world, q, what, self.options.clearance)

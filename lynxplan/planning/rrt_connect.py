@@ -418,9 +418,9 @@ def rrt_connect(
         nodes, parents, slacks, known = trees
         return (*fixed, nodes, parents, counts, roots, state, meta, CHUNK_ITERATIONS, slacks, known)
 
-    # the first call in a process: compile (or load) the kernel outside the time limit
-    if not rrt_connect_kernel.overloads:  # (its .signatures hashes each signature: 20 us)
-        began += compile_before_timing(rrt_connect_kernel, arguments(trees), "the planner")
+    # the first call in a process: compile (or load) the kernels outside the time limit
+    began += compile_before_timing(straight_goal, (start, goals, model, scratch, clearance))
+    began += compile_before_timing(rrt_connect_kernel, arguments(trees))
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.vstack([start, goals[k]])

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from lynxplan import _jit
 from lynxplan._arrays import kernel_input
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
@@ -18,6 +19,8 @@ from lynxplan.robots.selection import assemble_result
 
 if TYPE_CHECKING:
     from lynxplan.robots.robot import Robot, Target
+
+_jit.listen()  # the IK kernels: a notice when their first compile takes long
 
 _SIDES = ("front", "back")
 _ELBOWS = ("elbow-up", "elbow-down")

@@ -1,0 +1,82 @@
+"""Compiling ahead of the clock, and the stderr line when numba compiles for long."""
+
+from __future__ import annotations
+
+import ast
+import subprocess
+import sys
+
+import numba
+
+from lynxplan._jit import compile_before_timing
+
+
+def test_compile_before_timing_compiles_once_without_running() -> None:
+    @numba.njit
+    def twice(x: float) -> float:
+        return 2.0 * x
+
+    assert not twice.signatures
+    seconds = compile_before_timing(twice, (1.5,))
+    assert seconds > 0.0
+    assert [tuple(str(t) for t in s) for s in twice.signatures] == [("float64",)]
+    assert compile_before_timing(twice, (2.5,)) == 0.0
+    assert twice(2.5) == 5.0
+
+
+ANNOUNCE = """
+import io, sys
+import numba
+from lynxplan import _jit
+
+class Terminal(io.StringIO):
+    def isatty(self):
+        return True
+
+terminal = Terminal()
+sys.stderr = terminal
+_jit.NOTICE_AFTER = float(sys.argv[1])
+_jit.enable_notices()
+_jit.listen()
+
+@numba.njit
+def f(x):
+    return x + 1
+
+@numba.njit
+def g(x):
+    return f(x) * 2
+
+g(1)
+g(2.0)
+sys.__stdout__.write(repr(terminal.getvalue()))
+"""
+
+
+def _stderr_of_compiles(after: float) -> str:
+    done = subprocess.run(
+        [sys.executable, "-c", ANNOUNCE, str(after)],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    return str(ast.literal_eval(done.stdout))  # the repr written above
+
+
+def test_a_long_compile_is_announced_once_on_a_terminal() -> None:
+    said = _stderr_of_compiles(0.0)
+    assert said.count("\n") == 1, said
+    assert said.startswith("lynxplan: compiling numba kernels (once after installation")
+
+
+def test_a_short_compile_says_nothing() -> None:
+    assert _stderr_of_compiles(60.0) == ""
+
+
+def test_not_a_terminal_says_nothing() -> None:
+    quiet = ANNOUNCE.replace("return True", "return False")
+    done = subprocess.run(
+        [sys.executable, "-c", quiet, "0"], capture_output=True, text=True, timeout=120, check=True
+    )
+    assert done.stdout == "''"
