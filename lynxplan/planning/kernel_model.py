@@ -3,7 +3,9 @@
 :func:`kernel_model` turns a :class:`lynxplan.collision.CollisionWorld` and a list of pairs into
 one tuple of contiguous arrays (joints, primitives, pairs, pair motion rates, obstacles) that the
 numba kernels of :mod:`lynxplan.planning.validity` and :mod:`lynxplan.planning.certify` read;
-:func:`make_scratch` gives the matching work arrays.
+:func:`make_scratch` gives the matching work arrays. :func:`njit_no_refcount`,
+:func:`njit_refcounted` and :func:`stack_array` are how the kernels are compiled: the hot ones
+without numba's reference counting, their work rows on their stack.
 """
 
 from __future__ import annotations
