@@ -45,7 +45,12 @@ from lynxplan.planning.edge_walk import (
     reach_step,
     span_motion,
 )
-from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE, njit_no_refcount
+from lynxplan.planning.kernel_model import (
+    LANES,
+    OBSTACLE_SPHERE,
+    njit_no_refcount,
+    njit_refcounted,
+)
 from lynxplan.planning.lanes import (
     MAX_JOINTS,
     OUT_ARMS,
@@ -135,7 +140,7 @@ def _bound_at(
     return float(pair_bound(p, model, scratch))
 
 
-@numba.njit(cache=True)
+@njit_refcounted()
 def segment_rates(path: np.ndarray, model: Any) -> np.ndarray:
     """Motion bound of every pair per unit s on every segment: (M, nq) -> (M - 1, P), in [m]."""
     rates = model[9]
