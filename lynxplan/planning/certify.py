@@ -407,3 +407,22 @@ def waypoint_bounds(
         primitive_poses(path[n], model, scratch)
         poses[n] = scratch[3]
         all_pair_bounds(model, scratch[3], bounds[n])
+
+
+@numba.njit(cache=True)
+def verification_poses(
+    path: np.ndarray,
+    segment: np.ndarray,
+    parameter: np.ndarray,
+    pair: np.ndarray,
+    model: Any,
+    scratch: Any,
+    transforms: Any,
+    waypoints: Any,
+) -> None:
+    """:func:`row_transforms` of the rows (transforms: rotation (R, 2, 3, 3), translation
+    (R, 2, 3), in [m]) and :func:`waypoint_bounds` of path (N, nq) (waypoints: bounds (N, P), in
+    [m], poses (N, G, 4, 4)) in one call: the model and scratch tuples cross into compiled code
+    once (about 5 us a crossing)."""
+    row_transforms(path, segment, parameter, pair, model, scratch, transforms[0], transforms[1])
+    waypoint_bounds(path, model, scratch, waypoints[0], waypoints[1])

@@ -40,7 +40,7 @@ from lynxplan.planning.certify import (
     row_transforms,
     schedule,
     segment_rates,
-    waypoint_bounds,
+    verification_poses,
 )
 from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pairs
 
@@ -96,6 +96,16 @@ class ExactVerifier:
         self._result = world._coal_result_type()
         self._link_poses = [type(t)() for t in world._coal_link_poses]
         self._rows = tuple(tuple(int(v) for v in row) for row in self.pairs.tolist())
+        # per pair: (coal functor, first transform, second transform, is a self pair)
+        self._queries = tuple(
+            (
+                self._functors[p],
+                self._link_poses[a],
+                self._link_poses[b] if is_self else self._obstacle_poses[b],
+                bool(is_self),
+            )
+            for p, (a, b, is_self) in enumerate(self._rows)
+        )
         self.queries = 0
 
     def exact(self, poses: np.ndarray, pair: int) -> float:
@@ -124,21 +134,25 @@ class ExactVerifier:
         row_transforms(
             path, segment, parameter, pair, self.model, self.scratch, rotation, translation
         )
-        functors, request, result = self._functors, self._request, self._result
-        links, obstacles, rows = self._link_poses, self._obstacle_poses, self._rows
-        out = np.empty(count)
+        return self.exact_posed(pair, rotation, translation)
+
+    def exact_posed(
+        self, pair: np.ndarray, rotation: np.ndarray, translation: np.ndarray
+    ) -> np.ndarray:
+        """coal's signed distance of each row's pair (R,) with its primitives' world poses
+        rotation (R, 2, 3, 3), translation (R, 2, 3) (the second only for a self pair), in [m]:
+        shape (R,)."""
+        request, result, queries = self._request, self._result, self._queries
+        clear = result.clear
+        out = np.empty(len(pair))
         for r, p in enumerate(pair.tolist()):
-            a, b, is_self = rows[p]
-            first = links[a]
+            functor, first, second, is_self = queries[p]
             first.setTransform(rotation[r, 0], translation[r, 0])
             if is_self:
-                second = links[b]
                 second.setTransform(rotation[r, 1], translation[r, 1])
-            else:
-                second = obstacles[b]
-            result.clear()
-            out[r] = functors[p](first, second, request, result)
-        self.queries += count
+            clear()
+            out[r] = functor(first, second, request, result)
+        self.queries += len(out)
         return out
 
     def poses(self, path: np.ndarray, segment: np.ndarray, parameter: np.ndarray) -> np.ndarray:
@@ -221,8 +235,22 @@ class _PathCheck:
             )
 
     def run(self) -> None:
-        segment, parameter, pair, motion = self.verifier.schedule(self.path)
-        distance = self.verifier.exact_rows(self.path, segment, parameter, pair)
+        verifier, path = self.verifier, self.path
+        segment, parameter, pair, motion = verifier.schedule(path)
+        rotation, translation = np.empty((len(segment), 2, 3, 3)), np.empty((len(segment), 2, 3))
+        bounds = np.empty((len(path), len(verifier.pairs)))
+        poses = np.empty((len(path), len(verifier.world.links), 4, 4))
+        verification_poses(
+            path,
+            segment,
+            parameter,
+            pair,
+            verifier.model,
+            verifier.scratch,
+            (rotation, translation),
+            (bounds, poses),
+        )
+        distance = verifier.exact_posed(pair, rotation, translation)
         where = (segment + parameter).tolist()
         pairs = pair.tolist()
         self.known = dict(zip(zip(where, pairs, strict=True), distance.tolist(), strict=True))
@@ -231,7 +259,7 @@ class _PathCheck:
             r = int(touching[0])
             self._report_contact(where[r], pairs[r], float(distance[r]))
             return
-        self._waypoint_minimum()
+        self._waypoint_minimum(bounds, poses)
         if self.contact is not None or len(pairs) < 2:
             return
         # Consecutive rows of one chain (same segment and pair, a motion bound between them).
@@ -260,20 +288,19 @@ class _PathCheck:
                 return
             stack += [(a, s, da, d, depth + 1), (s, b, d, db, depth + 1)]
 
-    def _waypoint_minimum(self) -> None:
+    def _waypoint_minimum(self, bounds: np.ndarray, poses: np.ndarray) -> None:
         """Exact smallest distance over the waypoints, branch and bound on the planner's
-        bounds (every pair whose bound is below the best exact distance is queried)."""
-        verifier, count = self.verifier, len(self.path)
-        if not len(verifier.pairs):
+        bounds (N, P), in [m] (every pair whose bound is below the best exact distance is
+        queried, at the primitive poses (N, G, 4, 4) of its waypoint)."""
+        pairs = bounds.shape[1]
+        if not pairs:
             return
-        bounds = np.empty((count, len(verifier.pairs)))
-        poses = np.empty((count, len(verifier.world.links), 4, 4))
-        waypoint_bounds(self.path, verifier.model, verifier.scratch, bounds, poses)
+        flat_bounds = bounds.ravel().tolist()
         best = min(self.known.values(), default=np.inf)
         for flat in np.argsort(bounds, axis=None).tolist():
-            n, pair = divmod(flat, len(verifier.pairs))
-            if bounds[n, pair] >= best:
+            if flat_bounds[flat] >= best:
                 break
+            n, pair = divmod(flat, pairs)
             best = min(best, self.distance_at(poses[n], float(n), pair))
 
     def minimum(self) -> ClearanceRecord:
