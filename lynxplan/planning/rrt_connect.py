@@ -327,11 +327,13 @@ def straight_goal(
     return -1
 
 
-def _branch(nodes: np.ndarray, parents: np.ndarray, tree: int, index: int) -> list[np.ndarray]:
+def _branch(parents: np.ndarray, tree: int, index: int) -> list[int]:
+    """Node indices from ``index`` up to its tree's root (parents: (2, M), root parent -1)."""
     branch = []
+    row = parents[tree]
     while index >= 0:
-        branch.append(nodes[tree, index].copy())
-        index = int(parents[tree, index])
+        branch.append(index)
+        index = row.item(index)
     return branch
 
 
@@ -367,12 +369,6 @@ class _Trees(NamedTuple):
         for old, new in zip(self, bigger, strict=True):
             new[:, :rows] = old
         return bigger
-
-
-def _root_of(parents: np.ndarray, tree: int, index: int) -> int:
-    while parents[tree, index] >= 0:
-        index = int(parents[tree, index])
-    return index
 
 
 def rrt_connect(
@@ -446,12 +442,11 @@ def rrt_connect(
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
-    from_start = _branch(nodes, parents, 0, int(meta[1]))[::-1]
-    to_goal = _branch(nodes, parents, 1, int(meta[2]))
-    path = np.array(from_start + to_goal)
+    to_goal = _branch(parents, 1, int(meta[2]))
+    path = np.concatenate([nodes[0, _branch(parents, 0, int(meta[1]))[::-1]], nodes[1, to_goal]])
     keep = np.ones(len(path), dtype=bool)
     keep[1:] = np.linalg.norm(np.diff(path, axis=0), axis=1) > 1e-12
-    goal_index = _root_of(parents, 1, int(meta[2]))
+    goal_index = to_goal[-1]  # the goal tree's root the branch hangs on
     return RrtConnectResult(
         path[keep], goal_index, int(counts.sum()), int(meta[3]), time.perf_counter() - began
     )
