@@ -106,6 +106,7 @@ class ExactVerifier:
             )
             for p, (a, b, is_self) in enumerate(self._rows)
         )
+        self._self_pairs = int(world.pair_is_self.sum())
         self.queries = 0
 
     def exact(self, poses: np.ndarray, pair: int) -> float:
@@ -187,7 +188,7 @@ class ExactVerifier:
             raise PathVerificationError(check.contact)
         if not check.certified:
             raise PathVerificationError("an interval could not be certified (grazing contact)")
-        self_pairs = int(self.world.pair_is_self.sum())
+        self_pairs = self._self_pairs
         return VerificationReport(
             collision_free=True,
             min_clearance=check.minimum(),
