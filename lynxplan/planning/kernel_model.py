@@ -43,12 +43,7 @@ def njit_no_refcount(**options: Any) -> Callable[[_Kernel], _Kernel]:
     an atomic reference per array of the model and scratch tuples (about 40) and per view taken
     inside: a fifth of the planning time.
     """
-    settings: dict[str, Any] = {"cache": True, "_nrt": False, **options}
-
-    def compile_lazily(function: _Kernel) -> _Kernel:
-        return cast(_Kernel, numba.njit(**settings)(function))
-
-    return compile_lazily
+    return _njit(False, options)
 
 
 #: Alignment of a :func:`stack_array`, in bytes (a cache line: whole-register loads and stores).
@@ -60,7 +55,12 @@ def njit_refcounted(**options: Any) -> Callable[[_Kernel], _Kernel]:
     (``_nrt=True``): a kernel that allocates or returns an array, and may be called from
     :func:`njit_no_refcount` kernels (a callee that sets no ``_nrt`` is compiled with its first
     caller's setting: it would fail to allocate, or return a view without its reference)."""
-    settings: dict[str, Any] = {"cache": True, "_nrt": True, **options}
+    return _njit(True, options)
+
+
+def _njit(counted: bool, options: dict[str, Any]) -> Callable[[_Kernel], _Kernel]:
+    """The decorator ``numba.njit(cache=True, _nrt=counted, **options)``, typed."""
+    settings: dict[str, Any] = {"cache": True, "_nrt": counted, **options}
 
     def compile_lazily(function: _Kernel) -> _Kernel:
         return cast(_Kernel, numba.njit(**settings)(function))

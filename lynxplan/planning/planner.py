@@ -252,7 +252,6 @@ class Planner:
             self._require_certifiable(goals.configurations[free[0]], "goal")
         free = certifiable
         self._compile(q_start)
-        began = time.perf_counter()
         settings = RrtConnectSettings(
             self.options.step, self.options.goal_bias, self.options.max_nodes
         )
@@ -267,7 +266,6 @@ class Planner:
             settings=settings,
         )
         planned = time.perf_counter()
-        began = planned - found.elapsed  # without compiling its kernel (first call in a process)
         path, reached = shortcut_to_goals(
             self.checker,
             found.path,
@@ -296,7 +294,7 @@ class Planner:
             iterations=found.iterations,
             raw_waypoints=len(found.path),
             raw_length=self.space.path_length(found.path),
-            plan_time=planned - began,
+            plan_time=found.elapsed,  # without compiling its kernels (first call in a process)
             shortcut_time=shortened - planned,
             verify_time=verified - shortened,
             timing_time=done - verified,
