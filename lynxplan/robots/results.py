@@ -91,7 +91,10 @@ class BranchSlots(NamedTuple):
 
 
 class RobotIkBatch(NamedTuple):
-    """IK of N targets, every branch slot. Arrays are read-only; empty slots are NaN/False."""
+    """IK of N targets, every branch slot. Arrays are read-only; empty slots are NaN/False.
+
+    B, the number of slots, depends on the target kind and the tool (``Robot.ik_batch``): 4, 8
+    for full poses of an off-axis tool, 24 for its approach targets."""
 
     q: np.ndarray
     """Joint angles, shape (N, B, n), in [rad]; NaN in unused slots."""

@@ -261,7 +261,11 @@ class Robot:
 
         Returns:
             A :class:`RobotIkBatch`: unreachable targets get their nearest solution,
-            ``reachable`` False and the ``distance``.
+            ``reachable`` False and the ``distance``. Its B branch slots (``branch_names``):
+            4 (side x elbow) where the roll is given or the tool is on the roll axis; for an
+            off-axis tool, 8 for full poses (side x 2 rolls x elbow: the orientation fixes the
+            roll up to the flip of the yaw) and 24 for approach targets (side x 6 roots of the
+            roll equation x elbow).
         """
         target = make_target(poses, positions, approaches, pitches, rolls)
         return self._solve(target, self._reference(q_reference, target.poses.shape[0]))

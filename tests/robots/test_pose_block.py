@@ -17,9 +17,10 @@ import pytest
 
 from lynxplan._arrays import kernel_input
 from lynxplan.robots import Robot, load_robot
-from lynxplan.robots.ik import pose_kernel
+from lynxplan.robots.ik import family_solver, pose_kernel
 from lynxplan.robots.ik.pose_block import pose_block_kernel, smallest_errors
 from lynxplan.robots.results import BranchSlots
+from lynxplan.robots.targets import make_target
 from tests.robots.test_pose_kernel import _near_axis_poses
 from tests.robots.urdf_factory import tilted_urdf, write_random_family_urdfs
 
@@ -27,7 +28,7 @@ from tests.robots.urdf_factory import tilted_urdf, write_random_family_urdfs
 def _both(robot: Robot, poses: np.ndarray, reference: np.ndarray) -> tuple[tuple, tuple, int]:  # type: ignore[type-arg]
     family, chain = robot.family, robot.chain
     assert family is not None
-    slots = 4 if family.tool_on_roll_axis else 24
+    slots = 4 if family.tool_on_roll_axis else 4 * family_solver.POSE_ROLLS
     results = []
     fallbacks = 0
     for kernel in (pose_kernel.pose_kernel, pose_block_kernel):
@@ -168,3 +169,33 @@ def test_chain_turned_about_z_gives_the_same_poses() -> None:
             chain_fk(placements, axes, q, expected, np.empty((4, 4)))
             got = np.array(_fk(chain, *q)).reshape(3, 4)
             assert np.abs(got - expected[:3]).max() < 1e-14
+
+
+def test_full_poses_of_an_off_axis_tool_have_eight_slots() -> None:
+    """Full poses: side x two rolls x elbow. Targets of the general kernel (out of reach,
+    degenerate) are packed from its 24 root-search slots: every side whose branches use at
+    most two rolls keeps them all, packed branches are the kernel's own, and the nearest
+    solution is kept."""
+    robot = load_robot("so101")
+    poses = _mixed_poses(robot, seed=31)
+    batch = robot.ik_batch(poses)
+    assert batch.q.shape == (len(poses), 8, 5)
+    assert batch.branch_names[:3] == (
+        "front/roll-1/elbow-up",
+        "front/roll-1/elbow-down",
+        "front/roll-2/elbow-up",
+    )
+    target = make_target(poses)
+    full = BranchSlots.empty(len(poses), 24)
+    family_solver._kernel(robot, target, robot._default_reference, full)
+    packed = family_solver.pack_rolls(full, 2)
+    rolls_used = full.valid.reshape(-1, 2, 6, 2).any(axis=3).sum(axis=2).max(axis=1)
+    few = rolls_used <= 2
+    assert np.array_equal(packed.valid[few].sum(axis=1), full.valid[few].sum(axis=1))
+    for i in range(len(poses)):
+        for q in packed.q[i][packed.valid[i]]:
+            assert np.abs(full.q[i][full.valid[i]] - q).max(axis=1).min() == 0.0
+    nearest = np.where(full.valid, full.position_error, np.inf).min(axis=1)
+    assert np.array_equal(
+        np.where(packed.valid, packed.position_error, np.inf).min(axis=1), nearest
+    )

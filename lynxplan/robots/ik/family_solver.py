@@ -26,14 +26,29 @@ _SIDES = ("front", "back")
 _ELBOWS = ("elbow-up", "elbow-down")
 
 
+#: Full poses of an off-axis tool with the roll free: rolls per side in the batch layout. The
+#: orientation fixes the yaw up to a flip by pi, and with it the roll: a 5-joint arm of the family
+#: reaches one pose with at most two rolls per side (the flip's), each with two elbows.
+POSE_ROLLS = 2
+
+
 @functools.cache
 def branch_names(slots: int) -> tuple[str, ...]:
-    """Names of the branch slots: side/elbow (4 slots) or side/roll-i/elbow (root search)."""
+    """Names of the branch slots: side/elbow (4 slots) or side/roll-i/elbow (4 per roll)."""
     if slots == 4:
         return tuple(f"{s}/{e}" for s in _SIDES for e in _ELBOWS)
     return tuple(
-        f"{s}/roll-{r + 1}/{e}" for s in _SIDES for r in range(fk_.MAX_ROOTS) for e in _ELBOWS
+        f"{s}/roll-{r + 1}/{e}" for s in _SIDES for r in range(slots // 4) for e in _ELBOWS
     )
+
+
+def slot_count(robot: Robot, target: Target) -> int:
+    """Branch slots of the batch layout: 4 (side x elbow: the roll given, or fixed by the
+    orientation of a tool on the roll axis), 4 * POSE_ROLLS (full poses of an off-axis tool)
+    or 4 * MAX_ROOTS (approach targets of an off-axis tool: every root of the roll equation)."""
+    if not needs_root_search(robot, target):
+        return 4
+    return 4 * (POSE_ROLLS if target.kind == fk_.MODE_POSE else fk_.MAX_ROOTS)
 
 
 def needs_root_search(robot: Robot, target: Target) -> bool:
@@ -52,20 +67,21 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
     family = robot.family
     assert family is not None
     n = target.poses.shape[0]
-    slots = 4 * fk_.MAX_ROOTS if needs_root_search(robot, target) else 4
+    slots = slot_count(robot, target)
     out = BranchSlots.empty(n, slots)
     if target.kind == fk_.MODE_POSE and robot._arm is None:
         # the poses pose_block solves have their exact branches, each within REACH_TOLERANCE;
-        # the rest (out of reach, degenerate) goes through the general kernel
+        # the rest (out of reach, degenerate) goes through the general kernel (root search),
+        # its roots packed into the pose layout
         rest = ~_pose_fill(robot, target, reference, out)
         distance = smallest_errors(out.position_error)
         reachable = np.ones(n, dtype=np.bool_)
         if rest.any():
             sub, ref = _rows(target, reference, rest)
-            part = out.rows(rest)
+            part = BranchSlots.empty(sub.poses.shape[0], 4 if slots == 4 else 4 * fk_.MAX_ROOTS)
             _kernel(robot, sub, ref, part)
             reachable[rest], distance[rest] = _general(robot, sub, part)
-            out.put(rest, part)
+            out.put(rest, pack_rolls(part, slots // 4))
     else:
         if robot._arm is not None and target.kind != fk_.MODE_PITCH:
             out.clear()
@@ -91,6 +107,26 @@ def _rows(target: Target, reference: np.ndarray, mask: np.ndarray) -> tuple[Targ
     )
     ref = reference if reference.shape[0] == 1 else np.ascontiguousarray(reference[mask])
     return sub, ref
+
+
+def pack_rolls(part: BranchSlots, rolls: int) -> BranchSlots:
+    """The root-search layout (2 sides x R roots x 2 elbows) packed to ``rolls`` roots per side:
+    the roots whose branches come nearest the target position (in root order). A reachable
+    full pose has at most two rolls per side (``POSE_ROLLS``), so none of its branches is
+    dropped; an unreachable one keeps its nearest solutions."""
+    n, width = part.valid.shape
+    per_side = width // 4
+    if per_side <= rolls:
+        return part
+    nearest = np.where(part.valid, part.position_error, np.inf).reshape(n, 2, per_side, 2)
+    keep = np.sort(np.argsort(nearest.min(axis=3), axis=2, kind="stable")[:, :, :rolls], axis=2)
+
+    def packed(array: np.ndarray) -> np.ndarray:
+        shaped = array.reshape(n, 2, per_side, 2, *array.shape[2:])
+        index = keep.reshape(n, 2, rolls, *([1] * (shaped.ndim - 3)))
+        return np.take_along_axis(shaped, index, axis=2).reshape(n, 4 * rolls, *array.shape[2:])
+
+    return BranchSlots(*(packed(array) for array in part))
 
 
 def _general(robot: Robot, target: Target, out: BranchSlots) -> tuple[np.ndarray, np.ndarray]:
@@ -226,7 +262,7 @@ def solve_pose_one(
         return solve_al5_pose_one(robot, pose, reference, verify)
     family = robot.family
     assert family is not None
-    slots = 4 if family.tool_on_roll_axis else 4 * fk_.MAX_ROOTS
+    slots = 4 if family.tool_on_roll_axis else 4 * POSE_ROLLS
     table = np.empty((slots, _pk.SLOT_COLUMNS))
     chain = robot.chain
     count = _pk.pose_one(

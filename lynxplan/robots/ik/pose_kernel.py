@@ -12,9 +12,9 @@ orientation, so no other branch exists. Targets not solved here (the pose is out
 the nearest orientation is wanted; the approach along the yaw axis, which leaves the yaw to the
 position) go to the general kernel (``family_kernel``: the roll root search of an off-axis tool).
 
-Slots are those of the kernel's layouts, so one batch has one layout: ``side * 2 + elbow``
-(tool on the roll axis: each flip is one side) or ``side * per_side + 2 * flip + elbow`` (the
-root-search layout, the flip in the place of the root index). Angles in [rad], lengths in [m].
+Slots are those of the batch layouts (``family_solver.slot_count``): ``side * 2 + elbow``
+(tool on the roll axis: each flip is one side) or ``side * per_side + 2 * flip + elbow`` (an
+off-axis tool: the flip is the roll's index, ``per_side`` = 4). Angles in [rad], lengths in [m].
 """
 
 from __future__ import annotations
