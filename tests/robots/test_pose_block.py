@@ -114,13 +114,13 @@ def test_block_kernel_equals_scalar_kernel_on_random_family_urdfs(tmp_path: Path
 
 
 def test_vector_path_carries_the_load() -> None:
-    """On random reachable SO-101 poses at most 3 % fall back to the scalar solver (1.1 % when
-    written): a vector path that stopped taking its candidates would pass the equality tests
-    above while losing its speed."""
+    """On random reachable SO-101 poses at most 1 % fall back to the scalar solver (0.13 % with
+    the second vector polish of the candidates next to a fold): a vector path that stopped taking
+    its candidates would pass the equality tests above while losing its speed."""
     robot = load_robot("so101")
     poses = np.ascontiguousarray(robot.fk(robot.random_configurations(5000, seed=8)))
     _, _, fallbacks = _both(robot, poses, robot._default_reference)
-    assert fallbacks <= 0.03 * len(poses)
+    assert fallbacks <= 0.01 * len(poses)
 
 
 def test_smallest_errors_skips_empty_slots() -> None:

@@ -18,8 +18,11 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
 A candidate is *taken* here only when its final errors are below :data:`VECTOR_EXACT` (far below
 ``POSE_EXACT``), and *rejected* (not an exact branch) when its error stopped falling far above
 that. Any other candidate (still converging: next to a fold of the elbow Newton converges
-linearly; or an ill-conditioned polish) is finished by the scalar solver's own polish
-(``pose_kernel.polish_pose``) from its closed-form start, exactly as ``solve_target`` treats it.
+linearly; or an ill-conditioned polish) that came within NOT_A_BRANCH of the pose is polished
+once more from where it stopped, gathered with the others into whole vectors; what is still
+unfinished is finished by the scalar solver's own polish (``pose_kernel.polish_pose``) from its
+closed-form start, exactly as ``solve_target`` treats it. The candidate loops run on whole
+vectors of :data:`LANES` (padding lanes repeat a candidate).
 A pose where anything is unusual goes to the scalar ``solve_target``, whole: a near fold of a
 near-family model (where the scalar solver starts the elbows apart), both sides of the lateral
 offset matching the yaw, the approach along the yaw or the pitch axis, the target on the yaw
@@ -102,6 +105,8 @@ _C_Q, _C_FOLD, _C_PREV, _C_TAKE, _C_FALL, _C_IN, _C_PERR, _C_OERR = 12, 17, 18, 
 _C_START = 24  # the closed-form q (5), where a candidate that falls back starts
 _C_ROWS = 29
 _CW = 4 * BLOCK  # the candidate rows' width
+#: The candidate loops run on a multiple of this many lanes (AVX-512: 8 doubles).
+LANES = 8
 _ALL_TAKEN = np.ones(4, dtype=np.bool_)
 
 
@@ -549,6 +554,39 @@ def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
 
 
 @numba.njit(cache=True, nogil=True)
+def _repolish(
+    m: int, pr: Floats, ch: Floats, c_flat: np.ndarray, c2_flat: np.ndarray, index: np.ndarray
+) -> None:
+    """The m candidates in the rows c_flat that the polish left unfinished next to a branch
+    (final errors below NOT_A_BRANCH: next to a fold of the elbow the chord steps converge
+    slowly) polished once more from where they stopped, gathered into the rows c2_flat (whole
+    vectors): those that reach VECTOR_EXACT are taken, the others stay with the scalar polish
+    (from their closed-form start)."""
+    c, c2 = c_flat.reshape((_C_ROWS, _CW)), c2_flat.reshape((_C_ROWS, _CW))
+    count = 0
+    for k in range(m):
+        if (c[_C_FALL, k] != 0.0) & (max(c[_C_PERR, k], c[_C_OERR, k]) <= NOT_A_BRANCH):
+            index[count] = k
+            count += 1
+    if count == 0:
+        return
+    lanes = min((count + LANES - 1) // LANES * LANES, _CW)
+    for j in range(lanes):
+        k = index[min(j, count - 1)]
+        for row in range(_C_ROWS):
+            c2[row, j] = c[row, k]
+    _polish_all(lanes, ch, c2_flat)
+    _settle_all(lanes, pr, ch, c2_flat)
+    for j in range(count):
+        if c2[_C_TAKE, j] == 0.0:
+            continue
+        k = index[j]
+        for row in (_C_Q, _C_Q + 1, _C_Q + 2, _C_Q + 3, _C_Q + 4, _C_IN, _C_PERR, _C_OERR):
+            c[row, k] = c2[row, j]
+        c[_C_TAKE, k], c[_C_FALL, k] = 1.0, 0.0
+
+
+@numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
     """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
     of M'_1 .. M'_5, M'_tool (row-major; placements (6, 4, 4), axes (5, 3)).
@@ -610,6 +648,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
     shape = (math.hypot(l20, l21), math.hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30))
     s_flat, c_flat = np.empty(_ROWS * BLOCK), np.empty(_C_ROWS * _CW)
+    c2_flat, slot_index = np.empty(_C_ROWS * _CW), np.empty(_CW, dtype=np.int64)
     s, c = s_flat.reshape((_ROWS, BLOCK)), c_flat.reshape((_C_ROWS, _CW))
     first = np.empty(BLOCK + 1, dtype=np.int64)  # the candidates of pose i: first[i]..first[i+1]
     slot_of = np.empty(4 * BLOCK, dtype=np.int64)
@@ -656,9 +695,17 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     slot_of[mc] = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
                     mc += 1
         first[m] = mc
+        # whole vectors: the lanes past the last candidate repeat the first (a remainder
+        # would run through the loops' scalar epilogue, ~8 times the cost per candidate)
+        lanes = min((mc + LANES - 1) // LANES * LANES, _CW)
+        for lane in range(mc, lanes):
+            for k in range(_C_ROWS):
+                c[k, lane] = c[k, 0]
         if not exact:
-            _polish_all(mc, ch, c_flat)
-        _settle_all(mc, pr, ch, c_flat)
+            _polish_all(lanes, ch, c_flat)
+        _settle_all(lanes, pr, ch, c_flat)
+        if not exact:
+            _repolish(mc, pr, ch, c_flat, c2_flat, slot_index)
         stop = start + m  # every slot empty, then the branches written
         q_out[start:stop] = np.nan
         valid[start:stop] = False
