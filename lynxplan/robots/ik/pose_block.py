@@ -111,49 +111,61 @@ _ALL_TAKEN = np.ones(4, dtype=np.bool_)
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _acos(x: float) -> float:
-    """arccos of x in [-1, 1] (an atan2: accurate at the ends too, no branch)."""
-    return atan2(math.sqrt((1.0 - x) * (1.0 + x)), x)
+def _unit(y: float, x: float) -> tuple[float, float]:
+    """(sin, cos) of the angle of the vector (x, y): the vector normalised, no trigonometry
+    (NaN at the origin, where the callers leave the target to the scalar solver)."""
+    inverse = 1.0 / math.sqrt(x * x + y * y)
+    return y * inverse, x * inverse
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _pitch_sum(pr: Floats, a0: float, a1: float, a2: float, phi: float) -> tuple[float, bool]:
-    """Canonical pitch sum for yaw phi and approach a, and whether it is degenerate (the
-    approach along the pitch axis)."""
-    s, c = sincos(phi)
-    ap = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
-    ah = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
-    ak = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
-    x = c * ah - s * ap
-    return atan2(ak, x) - pr[F.GAMMA0], math.sqrt(x * x + ak * ak) <= 1e-12
+def _pitch_sum(
+    shape: Floats, a_h: float, a_p: float, a_k: float, s: float, c: float
+) -> tuple[float, float, float, bool]:
+    """Canonical pitch sum for the yaw of sine s and cosine c and the approach a (components
+    along h, p, k): the angle, its sine and cosine, and whether it is degenerate (the approach
+    along the pitch axis)."""
+    x = c * a_h - s * a_p
+    sx, cx = _unit(a_k, x)
+    sg, cg = shape[4], shape[5]  # of gamma0: the pitch sum is atan2(a_k, x) - gamma0
+    return (
+        atan2(a_k, x) - shape[6],
+        sx * cg - cx * sg,
+        cx * cg + sx * sg,
+        x * x + a_k * a_k <= 1e-24,
+    )
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _best_roll(pr: Floats, g: Floats, phi: float, big_phi: float) -> float:
-    """Canonical roll nearest the target (``family_geometry.best_roll``); g: the 9 entries of
-    G = Rt Rt0^T, row-major."""
-    sy, cy = sincos(-phi)
-    sp, cp = sincos(-big_phi)
-    sine, cosine = best_roll_terms(pr, g, cy, sy, cp, sp)
-    return atan2(sine, cosine)
+def _roll_terms(
+    pr: Floats, g: Floats, s_yaw: float, c_yaw: float, s_sum: float, c_sum: float
+) -> tuple[float, float]:
+    """(sin, cos) of the canonical roll nearest the target (``family_geometry.best_roll``) for
+    the yaw and pitch sum of these sines and cosines; g: the 9 entries of G = Rt Rt0^T,
+    row-major."""
+    sine, cosine = best_roll_terms(pr, g, c_yaw, -s_yaw, c_sum, -s_sum)
+    return _unit(sine, cosine)
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _yaw(
-    pr: Floats, dp: float, dh: float, rho: float, theta: float, side: int
-) -> tuple[float, float, bool]:
-    """Yaw of one side for roll theta (``family_geometry.yaw``), its lateral miss [m], and
-    whether the target is on the yaw axis (left to the scalar solver)."""
-    st, ct = sincos(theta)
+    pr: Floats, rho: float, alpha: Floats, st: float, ct: float, side: int
+) -> tuple[float, float, float, float, bool]:
+    """Yaw of one side for the roll of sine st and cosine ct (``family_geometry.yaw``), its
+    sine and cosine, the lateral miss [m], and whether the target is on the yaw axis (left to
+    the scalar solver); alpha: the angle of the target about the yaw axis, its sine, cosine."""
     lat = pr[F.LAM4] + pr[F.W0 + 2] + ct * pr[F.E1 + 2] + st * pr[F.E2 + 2]
     on_axis = (rho <= 1e-12) & (abs(lat) <= 1e-12)
     ratio = lat / rho if rho > 0.0 else math.copysign(1.0, lat)
     miss = lat - rho if ratio > 1.0 else 0.0
     miss = -lat - rho if ratio < -1.0 else miss
-    ratio = min(max(ratio, -1.0), 1.0)
-    beta = _acos(ratio)
-    alpha = atan2(dh, dp)
-    return (alpha + beta if side == 1 else alpha - beta), miss, on_axis
+    cb = min(max(ratio, -1.0), 1.0)
+    sb = math.sqrt((1.0 - cb) * (1.0 + cb))  # beta = arccos(ratio) in [0, pi]
+    beta = atan2(sb, cb)
+    a, sa, ca = alpha
+    if side == 1:  # alpha + beta
+        return a + beta, sa * cb + ca * sb, ca * cb - sa * sb, miss, on_axis
+    return a - beta, sa * cb - ca * sb, ca * cb + sa * sb, miss, on_axis
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -161,7 +173,11 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     """The closed-form branches of one flip of the yaw (both elbows) of the target t (12:
     row-major 3 x 4) on the ideal model: (q1, (q2, q3, q4) of elbow up, the same of elbow down,
     q5, candidate, fallback, side, near a fold of the elbow); shape: (la, lb, b2, b3) of the
-    two links (``family_geometry.two_link``)."""
+    two links (``family_geometry.two_link``), then sin, cos and the angle gamma0.
+
+    The angles enter the geometry through their sines and cosines, which come from the vectors
+    that define them (normalised): arctangents for the angles (two of them shared by both
+    flips), no sine or cosine."""
     rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
           pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
     g0 = t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]
@@ -179,6 +195,7 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     a2 = g6 * pr[F.R] + g7 * pr[F.R + 1] + g8 * pr[F.R + 2]
     a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
     a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
+    a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
     axial = math.sqrt(a_h * a_h + a_p * a_p) <= AXIAL_APPROACH
     d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
     dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
@@ -186,25 +203,32 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     dk = d0 * pr[F.K] + d1 * pr[F.K + 1] + d2 * pr[F.K + 2]
     rho = math.sqrt(dp * dp + dh * dh)
     match = YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12)
+    # the yaw that puts the approach in the arm plane, flipped by pi: its sine and cosine flip
+    sign = 1.0 - 2.0 * flip
     phi = atan2(-a_p, a_h) + flip * math.pi
-    big_phi, flat1 = _pitch_sum(pr, a0, a1, a2, phi)
-    theta = _best_roll(pr, g, phi, big_phi)
-    yaw0, lat_miss, on_axis = _yaw(pr, dp, dh, rho, theta, 0)
-    yaw1, _, _ = _yaw(pr, dp, dh, rho, theta, 1)
+    s_phi, c_phi = _unit(-a_p, a_h)
+    s_phi, c_phi = sign * s_phi, sign * c_phi
+    _, s_big, c_big, flat1 = _pitch_sum(shape, a_h, a_p, a_k, s_phi, c_phi)
+    st, ct = _roll_terms(pr, g, s_phi, c_phi, s_big, c_big)
+    s_alpha, c_alpha = _unit(dh, dp)
+    alpha = (atan2(dh, dp), s_alpha, c_alpha)
+    yaw0, s_yaw0, c_yaw0, lat_miss, on_axis = _yaw(pr, rho, alpha, st, ct, 0)
+    yaw1, s_yaw1, c_yaw1, _, _ = _yaw(pr, rho, alpha, st, ct, 1)
     lat_ok = lat_miss <= REACH_MISS
     ok0 = lat_ok & (abs(wrap(yaw0 - phi)) <= match)
     ok1 = lat_ok & (abs(wrap(yaw1 - phi)) <= match)
     side = 1.0 if ok1 else 0.0
     phi2 = yaw1 if ok1 else yaw0
-    big2, flat2 = _pitch_sum(pr, a0, a1, a2, phi2)
-    theta = _best_roll(pr, g, phi2, big2) if pr[F.OFF_AXIS] == 0.0 else theta
-    s2, c2 = sincos(phi2)
+    s2, c2 = (s_yaw1, c_yaw1) if ok1 else (s_yaw0, c_yaw0)
+    big2, sp, cp, flat2 = _pitch_sum(shape, a_h, a_p, a_k, s2, c2)
+    st2, ct2 = _roll_terms(pr, g, s2, c2, sp, cp)  # a tool on the roll axis: of the side's yaw
+    on_roll_axis = pr[F.OFF_AXIS] == 0.0
+    st, ct = (st2, ct2) if on_roll_axis else (st, ct)
+    theta = atan2(st, ct)
     x, y = c2 * dh - s2 * dp, dk
-    st, ct = sincos(theta)
     wh = pr[F.W0] + ct * pr[F.E1] + st * pr[F.E2]
     wk = pr[F.W0 + 1] + ct * pr[F.E1 + 1] + st * pr[F.E2 + 1]
-    sp, cp = sincos(big2)
-    la, lb, b2, b3 = shape
+    la, lb, b2, b3 = shape[0], shape[1], shape[2], shape[3]
     rx = x - (cp * wh - sp * wk) - pr[F.O2]
     ry = y - (sp * wh + cp * wk) - pr[F.O2 + 1]
     dist = math.sqrt(rx * rx + ry * ry)
@@ -215,8 +239,8 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     # where the scalar solver starts the two elbows apart (a near-family model): its result
     fold_start = (pr[F.EXACT] == 0.0) & (abs(cosd) > 1.0 - 1e-6)
     fold = abs(cosd) > 1.0 - FOLD_BAND
-    delta = _acos(cosd)
-    sd, cd = sincos(delta)
+    sd, cd = math.sqrt((1.0 - cosd) * (1.0 + cosd)), cosd  # delta = arccos(cosd) in [0, pi]
+    delta = atan2(sd, cd)
     toward = atan2(ry, rx)
     bend = atan2(lb * sd, la + lb * cd)
     miss = math.sqrt(reach * reach + lat_miss * lat_miss)
@@ -646,7 +670,16 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     lower, upper, tol = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5], prm[F.LIMIT_TOL]
     l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
-    shape = (math.hypot(l20, l21), math.hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30))
+    gamma0 = prm[F.GAMMA0]
+    shape = (
+        math.hypot(l20, l21),
+        math.hypot(l30, l31),
+        math.atan2(l21, l20),
+        math.atan2(l31, l30),
+        math.sin(gamma0),
+        math.cos(gamma0),
+        gamma0,
+    )
     s_flat, c_flat = np.empty(_ROWS * BLOCK), np.empty(_C_ROWS * _CW)
     c2_flat, slot_index = np.empty(_C_ROWS * _CW), np.empty(_CW, dtype=np.int64)
     s, c = s_flat.reshape((_ROWS, BLOCK)), c_flat.reshape((_C_ROWS, _CW))
