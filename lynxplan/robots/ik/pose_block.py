@@ -10,8 +10,8 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
    whose yaw matches, the two-link shoulder and elbow);
 2. on a model only close to the family, a fixed polish on the exact chain: one Gauss-Newton step
    (pose and geometric Jacobian, the normal equations by an LDL^T factorisation), then
-   two chord steps with the same factors (from ~1e-6 away the error falls to ~1e-12, then
-   ~1e-18; the second step settles the candidates that start farther away);
+   one chord step with the same factors (from ~1e-6 away the error falls to ~1e-12, then
+   ~1e-18; candidates that start farther away get a second polish, below);
 3. the angles wrapped into the joint limits, and the pose of the exact chain at the final
    angles: the position and orientation errors that are reported.
 
@@ -439,9 +439,9 @@ def _chord(
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
-    """One Gauss-Newton step and two chord steps on the exact chain from q: the final q,
+    """One Gauss-Newton step and one chord step on the exact chain from q: the final q,
     the smallest over the largest LDL^T pivot of J^T J (its conditioning), and the largest
-    component of the pose error before the last chord step."""
+    component of the pose error before the chord step."""
     p = _base(ch)
     o0 = _axis_of(p)
     p = _joint(ch, 0, p, q0)
@@ -459,7 +459,6 @@ def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q
     x = _step(lower, inverse, j0, j1, j2, j3, j4, _error(p, t))
     q0, q1, q2, q3, q4 = q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4]
     jac = (j0, j1, j2, j3, j4)
-    q0, q1, q2, q3, q4, _ = _chord(ch, t, lower, inverse, jac, q0, q1, q2, q3, q4)
     q0, q1, q2, q3, q4, size = _chord(ch, t, lower, inverse, jac, q0, q1, q2, q3, q4)
     return q0, q1, q2, q3, q4, ratio, size
 
