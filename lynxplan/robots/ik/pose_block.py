@@ -738,14 +738,15 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         _settle_all(lanes, pr, ch, c_flat)
         if not exact:
             _repolish(mc, pr, ch, c_flat, c2_flat, slot_index)
-        stop = start + m  # every slot empty, then the branches written
-        q_out[start:stop] = np.nan
-        valid[start:stop] = False
-        within[start:stop] = False
-        position_error[start:stop] = np.nan
-        orientation_error[start:stop] = np.nan
         for i in range(m):
             n = start + i
+            for b in range(nb):  # every slot empty, then the branches written
+                for j in range(5):
+                    q_out[n, b, j] = np.nan
+                valid[n, b] = False
+                within[n, b] = False
+                position_error[n, b] = np.nan
+                orientation_error[n, b] = np.nan
             if s[_POSE_FALL, i] != 0.0:
                 fallbacks += 1
                 ref = reference[n if reference.shape[0] > 1 else 0]
