@@ -4,7 +4,9 @@ caller passes (read-only or writable arrays, literal flags).
 numba compiles a kernel once per argument type (a read-only array, a literal ``True`` and a
 ``bool`` are different types); each extra version of the planner's edge walk or of the IK
 kernels costs tens of seconds of compile on first use. The workload runs in a fresh process,
-which loads the kernels from numba's cache for exactly the types it calls them with.
+which loads the kernels from numba's cache for exactly the types it calls them with; the
+planner's inner kernels (compiled from the others) must have one version in numba's cache
+index, none of them for a literal argument.
 """
 
 from __future__ import annotations
@@ -62,6 +64,22 @@ kernels = {
     "pose_block_kernel": pose_block.pose_block_kernel,
 }
 print(json.dumps({name: len(k.signatures) for name, k in kernels.items()}))
+
+# The planner's inner kernels, compiled from other kernels (now or in an earlier process): the
+# versions in numba's cache index for the current sources.
+import importlib, pkgutil
+import numba
+import lynxplan.planning
+cached = {}
+for info in pkgutil.iter_modules(lynxplan.planning.__path__):
+    module = importlib.import_module(f"lynxplan.planning.{info.name}")
+    for name, value in vars(module).items():
+        cache = getattr(value, "_cache", None)
+        own = getattr(value, "__module__", None) == module.__name__
+        if isinstance(value, numba.core.dispatcher.Dispatcher) and own:
+            index = cache._cache_file._load_index() if hasattr(cache, "_cache_file") else {}
+            cached[f"{info.name}.{name}"] = [str(key[0]) for key in index]
+print(json.dumps(cached))
 """
 
 
@@ -75,7 +93,18 @@ def test_each_big_kernel_has_one_compiled_signature() -> None:
         check=False,
     )
     assert done.returncode == 0, done.stderr[-3000:]
-    counts = json.loads(done.stdout.strip().splitlines()[-1])
+    counts = json.loads(done.stdout.strip().splitlines()[-2])
     assert all(count <= 1 for count in counts.values()), counts
     for name in ("rrt_connect_kernel", "shortcut_kernel", "ik_kernel", "ik_single_kernel"):
         assert counts[name] == 1, counts  # used by the workload
+    # Inside compiled code a constant argument is a literal type (a literal 0 or 2 where the
+    # callee also gets an int64 compiles it twice: the certification's chain took 15 s a time).
+    cached = json.loads(done.stdout.strip().splitlines()[-1])
+    assert len([name for name, signatures in cached.items() if signatures]) >= 20, cached
+    repeated = {name: signatures for name, signatures in cached.items() if len(signatures) > 1}
+    literal = {
+        name: signatures
+        for name, signatures in cached.items()
+        if any("Literal" in signature for signature in signatures)
+    }
+    assert not repeated and not literal, (repeated, literal)

@@ -168,7 +168,9 @@ def poses_with_deviation(
         stack = np.ascontiguousarray(stack)
     if stack.shape[0] > 1:
         check_size(f"{name}: poses in one batch", stack.shape[0])
-    k, code, detail = pose_check_kernel(stack, MAX_ABS_LENGTH, approach_only).tolist()
+    checked = stack.view()  # read-only: one compiled kernel for writable and read-only input
+    checked.flags.writeable = False
+    k, code, detail = pose_check_kernel(checked, MAX_ABS_LENGTH, approach_only).tolist()
     if code == POSE_OK:
         return (stack if array.ndim == 3 else stack[0]), detail
     at = f"{name}[{int(k)}]" if array.ndim == 3 else name

@@ -177,7 +177,7 @@ def _sphere_chain(
     arms = scratch[13]
     if gap <= 0.0:
         return False
-    _bound_at(q_a, q_b, 0.0, p, model, scratch, 0, True)
+    pose_pair_at(q_a, q_b, 0.0, p, model, scratch, 0)  # its lever arms (gap: the caller's)
     gap_end = _bound_at(q_a, q_b, 1.0, p, model, scratch, 1, True)
     if gap_end > 0.0 and gap + gap_end > span_motion(p, 1.0, model, scratch):
         return True  # one two-sided interval: the whole segment
@@ -270,7 +270,7 @@ def _chain(
     for j in range(q_a.shape[0]):
         static += model[9][p, j] * scratch[14][j]
     s, b = 0.0, ends[0]
-    _bound_at(q_a, q_b, 0.0, p, model, scratch, 0, False)
+    pose_pair_at(q_a, q_b, 0.0, p, model, scratch, 0)  # its lever arms (b: the caller's)
     while True:
         if count >= pair.shape[0]:
             return -1
@@ -283,12 +283,12 @@ def _chain(
             s, b = 1.0, ends[1]
             continue
         t = min(1.0, s + STEP_GROWTH * reach_step(b, p, arms, 0, model, scratch))
-        bt = _bound_at(q_a, q_b, t, p, model, scratch, 1, False)
-        span = span_motion(p, t - s, model, scratch)
-        while b + bt <= span and t - s >= MIN_STEP:
-            t = s + 0.5 * (t - s)
+        while True:  # halve the step until the two-sided test passes (one inlined bound)
             bt = _bound_at(q_a, q_b, t, p, model, scratch, 1, False)
             span = span_motion(p, t - s, model, scratch)
+            if b + bt > span or t - s < MIN_STEP:
+                break
+            t = s + 0.5 * (t - s)
         if t - s < MIN_STEP:
             motion[count - 1] = static * (1.0 - s)
             s, b = 1.0, ends[1]
@@ -315,7 +315,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
     todo = np.empty(count_pairs, dtype=np.bool_)
     gaps = np.empty((SPHERE_GRID + 1, count_pairs))
     arms = np.empty(((SPHERE_GRID + 1) * count_pairs, path.shape[1]))
-    count = 0
+    count = np.int64(0)  # not a literal 0: numba would compile _chain for it as well
     for k in range(path.shape[0] - 1):
         for j in range(path.shape[1]):
             scratch[14][j] = abs(path[k + 1, j] - path[k, j])
@@ -345,7 +345,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
                 if count < 0:
                     return -1
             segment[first:count] = k
-    return count
+    return int(count)
 
 
 @numba.njit(cache=True)

@@ -437,6 +437,36 @@ def _lane_run(
 
 
 @njit_no_refcount()
+def _two_sided_step(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    p: int,
+    s: float,
+    t: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> bool:
+    """The scalar walk's two-sided step of pair p from s to t (models with too many joints
+    for the lanes): certified when its slack at t exceeds :data:`STALL_DISTANCE` and the two
+    ends' slacks its motion bound (:func:`span_motion`); the pair's state then moves to t.
+    A compiled call, not inlined: a walk with lanes never comes here, and each inlined copy of
+    the pose code lengthens :func:`edge_walk`'s first compile."""
+    slack, reach, where = scratch[4], scratch[5], scratch[6]
+    all_arms, trend = scratch[15], scratch[16]
+    slack_t = _pair_at(q_a, q_b, t, p, model, scratch, 1) - clearance
+    if not (
+        slack_t > STALL_DISTANCE and slack[p] + slack_t > span_motion(p, t - s, model, scratch)
+    ):
+        return False
+    trend[p] = (slack_t - slack[p]) / (t - s)
+    where[p], slack[p] = t, slack_t
+    copy_row(all_arms, p, scratch[13], 1)
+    reach[p] = t + reach_step(slack_t, p, all_arms, p, model, scratch)
+    return True
+
+
+@njit_no_refcount()
 def edge_walk(
     q_a: np.ndarray,
     q_b: np.ndarray,
@@ -471,7 +501,7 @@ def edge_walk(
         return -1.0
     lanes = model[0].shape[0] <= MAX_JOINTS and q_a.shape[0] <= MAX_JOINTS
     while True:
-        p, nearest = 0, np.inf
+        p, nearest = np.int64(0), np.inf  # (a literal 0 would compile pair_along twice)
         for k in range(count):
             if reach[k] < nearest:
                 p, nearest = k, reach[k]
@@ -495,14 +525,7 @@ def edge_walk(
                 return -run
         if not lanes and span > 1.2 * one:  # (the lanes' first point was this one)
             t = min(1.0, s + min(span, MAX_GROWTH * one))
-            slack_t = _pair_at(q_a, q_b, t, p, model, scratch, 1) - clearance
-            if slack_t > STALL_DISTANCE and slack[p] + slack_t > span_motion(
-                p, t - s, model, scratch
-            ):
-                trend[p] = (slack_t - slack[p]) / (t - s)
-                where[p], slack[p] = t, slack_t
-                copy_row(all_arms, p, arms, 1)
-                reach[p] = t + reach_step(slack_t, p, all_arms, p, model, scratch)
+            if _two_sided_step(q_a, q_b, p, s, t, model, scratch, clearance):
                 continue
         slack_t = _pair_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
         if slack_t <= STALL_DISTANCE:

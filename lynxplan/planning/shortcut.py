@@ -114,7 +114,7 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
     slacks = np.empty((count, model[8].shape[0]))
     known = np.zeros(count, dtype=np.bool_)
     kept = 0
-    i = 0
+    i = np.int64(0)  # not a literal 0: numba would compile _slacks_at for it as well
     while i < count - 1:
         j = count - 1
         while j > i + 1:
@@ -216,7 +216,8 @@ def _full(
         not edge_is_free_after_midpoint(first, second, model, scratch, clearance)
     ):
         return 0
-    return _splice(path, count, i1, i2, piece, 2, work)  # path[..i1], first, second, path[i2+1..]
+    # path[..i1], first, second, path[i2+1..] (np.int64: no extra compile for a literal 2)
+    return _splice(path, count, i1, i2, piece, np.int64(2), work)
 
 
 @numba.njit(cache=True)

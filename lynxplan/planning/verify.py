@@ -41,6 +41,7 @@ from lynxplan.planning.certify import (
     schedule,
     segment_rates,
     verification_poses,
+    waypoint_bounds,
 )
 from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pairs
 
@@ -161,6 +162,26 @@ class ExactVerifier:
         out = np.empty((len(segment), len(self.world.links), 4, 4))
         configuration_poses(path, segment, parameter, self.model, self.scratch, out)
         return out
+
+    def closest(self, q: np.ndarray) -> tuple[float, int]:
+        """coal's smallest signed distance over every pair at q (nq,), in [m], and its pair
+        (inf, -1 without pairs). Branch and bound: the pairs are queried in the order of the
+        planner's tight lower bounds (one compiled call for all of them) until a positive
+        bound reaches the best exact distance (a bound <= 0 proves nothing: such a pair is
+        always queried); usually one or two coal queries instead of one per pair."""
+        config = np.ascontiguousarray(np.reshape(q, (1, -1)), dtype=float)
+        bounds = np.empty((1, len(self.pairs)))
+        poses = np.empty((1, len(self.world.links), 4, 4))
+        waypoint_bounds(config, self.model, self.scratch, bounds, poses)
+        best, best_pair = np.inf, -1
+        lower = bounds[0].tolist()
+        for pair in np.argsort(bounds[0], kind="stable").tolist():
+            if lower[pair] > 0.0 and lower[pair] >= best:
+                break
+            distance = self.exact(poses[0], pair)
+            if distance < best:
+                best, best_pair = distance, pair
+        return best, best_pair
 
     def schedule(self, path: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The rows (segment, s, pair, motion to the next row) to query exactly
@@ -344,13 +365,13 @@ def verify_path(
 
 
 def closest_contact(world: CollisionWorld, q: np.ndarray) -> tuple[float, str, str]:
-    """Exact smallest signed distance at q (nq,), with its link and obstacle names, in [m]."""
-    distances = world.distances(q)[0]
-    if distances.size == 0:
+    """Exact smallest signed distance at q (nq,), with its link and obstacle names, in [m]
+    (:meth:`ExactVerifier.closest`: coal distances, branch and bound on the planner's bounds)."""
+    distance, pair = verifier_of(world).closest(np.asarray(q, dtype=float))
+    if pair < 0:
         return float("inf"), "", ""
-    pair = int(np.argmin(distances))
     link, _geometry, obstacle = world.pair_names(pair)
-    return float(distances[pair]), link, obstacle
+    return float(distance), link, obstacle
 
 
 def require_clear(world: CollisionWorld, q: np.ndarray, what: str, clearance: float) -> float:
