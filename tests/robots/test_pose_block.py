@@ -114,7 +114,7 @@ def test_block_kernel_equals_scalar_kernel_on_random_family_urdfs(tmp_path: Path
 
 
 def test_vector_path_carries_the_load() -> None:
-    """On random reachable SO-101 poses at most 1 % fall back to the scalar solver (0.13 % with
+    """On random reachable SO-101 poses at most 1 % fall back to the scalar solver (~0.15 % with
     the second vector polish of the candidates next to a fold): a vector path that stopped taking
     its candidates would pass the equality tests above while losing its speed."""
     robot = load_robot("so101")
