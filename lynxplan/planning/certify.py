@@ -123,20 +123,10 @@ def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: A
 
 @numba.njit(cache=True, inline="always")
 def _bound_at(
-    q_a: np.ndarray,
-    q_b: np.ndarray,
-    s: float,
-    p: int,
-    model: Any,
-    scratch: Any,
-    side: int,
-    sphere: bool,
+    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
 ) -> float:
-    """Pair p's bound at q_a + s (q_b - q_a): its sphere gap if ``sphere`` else the tight one;
-    its lever arms -> scratch[13][side]."""
+    """Pair p's tight bound at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
     pose_pair_at(q_a, q_b, s, p, model, scratch, side)
-    if sphere:
-        return float(sphere_gap(p, model, scratch))
     return float(pair_bound(p, model, scratch))
 
 
@@ -177,8 +167,9 @@ def _sphere_chain(
     arms = scratch[13]
     if gap <= 0.0:
         return False
-    pose_pair_at(q_a, q_b, 0.0, p, model, scratch, 0)  # its lever arms (gap: the caller's)
-    gap_end = _bound_at(q_a, q_b, 1.0, p, model, scratch, 1, True)
+    for side in range(2):  # lever arms at both ends (one inlined copy of the pose code)
+        pose_pair_at(q_a, q_b, float(side), p, model, scratch, side)
+    gap_end = float(sphere_gap(p, model, scratch))  # at s = 1 (gap at 0: the caller's)
     if gap_end > 0.0 and gap + gap_end > span_motion(p, 1.0, model, scratch):
         return True  # one two-sided interval: the whole segment
     if model[0].shape[0] > MAX_JOINTS:  # too many joints for the lanes: the exact chain
@@ -284,7 +275,7 @@ def _chain(
             continue
         t = min(1.0, s + STEP_GROWTH * reach_step(b, p, arms, 0, model, scratch))
         while True:  # halve the step until the two-sided test passes (one inlined bound)
-            bt = _bound_at(q_a, q_b, t, p, model, scratch, 1, False)
+            bt = _bound_at(q_a, q_b, t, p, model, scratch, 1)
             span = span_motion(p, t - s, model, scratch)
             if b + bt > span or t - s < MIN_STEP:
                 break
