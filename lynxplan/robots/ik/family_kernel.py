@@ -158,8 +158,26 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                 if not exact:
                     count = exact_candidates(
                         problem,
-                        (problem, chain_problem, 0, q, scratch, scratch4, scratch5, trial),
-                        (problem, chain_problem, 1, q, scratch, scratch4, scratch5, trial),
+                        (
+                            problem,
+                            chain_problem,
+                            np.int64(0),
+                            q,
+                            scratch,
+                            scratch4,
+                            scratch5,
+                            trial,
+                        ),
+                        (
+                            problem,
+                            chain_problem,
+                            np.int64(1),
+                            q,
+                            scratch,
+                            scratch4,
+                            scratch5,
+                            trial,
+                        ),
                         grid_x,
                         grid_f,
                         m,

@@ -698,7 +698,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     s[4 * r + col, i] = targets[start + i, r, col]
         _closed_forms(m, pr, shape, s_flat)
         # the candidates of the poses that need no fallback, in the scalar solver's order
-        mc = 0
+        mc = np.int64(0)  # not a literal 0: one compile of _repolish
         for i in range(m):
             first[i] = mc
             fall = False
@@ -762,7 +762,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     position_error[n, b] = out[b, POSITION_ERROR]
                     orientation_error[n, b] = out[b, ORIENTATION_ERROR]
                 continue
-            count = 0
+            count = np.int64(0)  # not a literal 0: one compile of is_duplicate
             scalar = False
             for k in range(first[i], first[i + 1]):
                 b = slot_of[k]

@@ -214,16 +214,17 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
     )
     match = YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12)
     solved = False
+    mode = np.int64(MODE_POSE)  # not a literal: pitch_sum and branch compile once, for every mode
     for flip in range(2):
         # the yaw that puts the approach in the arm plane (its outward component > 0 or < 0)
         phi = math.atan2(-a_p, a_h) + flip * math.pi
-        big_phi, _ = pitch_sum(prm, MODE_POSE, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
+        big_phi, _ = pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
         theta = best_roll(prm, g, phi, big_phi)
         for side in range(2):
             phi_side, lateral = yaw(prm, d0, d1, d2, theta, side, phi_ref)
             if lateral > REACH_MISS or abs(wrap(phi_side - phi)) > match:
                 continue
-            problem = (prm, target, g, MODE_POSE, side, phi_ref, sum_ref)
+            problem = (prm, target, g, mode, side, phi_ref, sum_ref)
             for elbow in range(2):
                 b = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
                 if out[b, VALID] != 0.0:

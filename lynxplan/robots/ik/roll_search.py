@@ -283,7 +283,10 @@ def roll_candidates(
     by Brent's minimisation and both halves bracketed.
     """
     near = problem[0][F.EXACT] == 0.0
-    return _scan(problem, problem, xs, fs, m, roots, 0, near, True, True)
+    # int64 and np.bool_, not literals: numba compiles a callee once per literal value
+    return _scan(
+        problem, problem, xs, fs, m, roots, np.int64(0), near, np.bool_(True), np.bool_(True)
+    )
 
 
 @numba.njit(cache=True, nogil=True)
@@ -295,9 +298,9 @@ def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
     m: int,
     roots: np.ndarray,
     count: int,
-    near_roots: bool,
-    lo_end: bool,
-    hi_end: bool,
+    near_roots: bool | np.bool_,
+    lo_end: bool | np.bool_,
+    hi_end: bool | np.bool_,
 ) -> int:
     """The roots of problem's equation sampled at xs[: m + 1] (fs; NaN where undefined) added to
     roots[:count]; returns the new count. ``near_roots``: a near root of the ideal equation
@@ -348,7 +351,7 @@ def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
                 count = _keep_root(ideal, x, roots, count)
     # an extremum at either end of the range hides roots the scan above cannot see
     if lo_end and m > 0:
-        count = _end_roots(problem, ideal, xs, fs, 0, 1, roots, count)
+        count = _end_roots(problem, ideal, xs, fs, np.int64(0), np.int64(1), roots, count)
     if hi_end and m > 0:
         count = _end_roots(problem, ideal, xs, fs, m, m - 1, roots, count)
     return count
@@ -520,7 +523,7 @@ def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
         i = j + 1
         if _simple_crossing(fs, lo, hi, m):
             continue  # one well-conditioned root: the ideal one, polished on the exact chain
-        kept = dropped = 0  # the ideal roots of the stretch: set aside, tried last
+        kept = dropped = np.int64(0)  # the ideal roots of the stretch: set aside, tried last
         for r in range(count):
             if not xs[lo] <= roots[r] <= xs[hi]:
                 roots[kept], roots[MAX_ROOTS + kept] = roots[r], roots[MAX_ROOTS + r]
@@ -536,7 +539,16 @@ def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
                 continue
             before = count
             count = _scan(
-                exact, problem, ys, es, n, roots, count, False, ys[0] == xs[0], ys[n] == xs[m]
+                exact,
+                problem,
+                ys,
+                es,
+                n,
+                roots,
+                count,
+                np.bool_(False),
+                ys[0] == xs[0],
+                ys[n] == xs[m],
             )
             for k in range(n + 1):
                 if edges[k] >= 0:
