@@ -94,20 +94,24 @@ class ApproachGoal:
             array.setflags(write=False)
             object.__setattr__(self, name, array)
 
-    def poses(self) -> np.ndarray:
-        """Tool poses at ``roll_samples`` rolls about the approach axis, shape (R, 4, 4)."""
+    def pose_at(self, angle: float) -> np.ndarray:
+        """The tool pose rolled by ``angle`` [rad] about the approach axis, shape (4, 4)."""
         z = self.approach
         helper = np.array([1.0, 0.0, 0.0]) if abs(z[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
         x0 = np.cross(helper, z)
         x0 /= np.linalg.norm(x0)
         y0 = np.cross(z, x0)
-        poses = np.zeros((self.roll_samples, 4, 4))
-        for k, angle in enumerate(np.linspace(0.0, 2 * np.pi, self.roll_samples, endpoint=False)):
-            x = np.cos(angle) * x0 + np.sin(angle) * y0
-            poses[k, :3, :3] = np.column_stack((x, np.cross(z, x), z))
-            poses[k, :3, 3] = self.position
-            poses[k, 3, 3] = 1.0
-        return poses
+        x = np.cos(angle) * x0 + np.sin(angle) * y0
+        pose = np.zeros((4, 4))
+        pose[:3, :3] = np.column_stack((x, np.cross(z, x), z))
+        pose[:3, 3] = self.position
+        pose[3, 3] = 1.0
+        return pose
+
+    def poses(self) -> np.ndarray:
+        """Tool poses at ``roll_samples`` rolls about the approach axis, shape (R, 4, 4)."""
+        angles = np.linspace(0.0, 2 * np.pi, self.roll_samples, endpoint=False)
+        return np.array([self.pose_at(float(angle)) for angle in angles]).reshape(-1, 4, 4)
 
 
 Goal = JointGoal | PoseGoal | ApproachGoal
@@ -185,17 +189,18 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
     approach_only = isinstance(goal, ApproachGoal)
     if isinstance(goal, PoseGoal) or not isinstance(robot, Arm):
         # A URDF robot's IK leaves the roll free for an approach goal: every root, exactly.
-        poses = goal.pose[None] if isinstance(goal, PoseGoal) else goal.poses()[:1]
+        poses = goal.pose[None] if isinstance(goal, PoseGoal) else goal.pose_at(0.0)[None]
         references = [None]
     else:
         # The roll about the approach axis is the last joint's (yaw-pitch^3-roll family): one
         # IK per sampled last-joint angle.
         rolls = np.linspace(space.lower[-1], space.upper[-1], goal.roll_samples)
-        poses = np.repeat(goal.poses()[:1], len(rolls), axis=0)
+        poses = np.repeat(goal.pose_at(0.0)[None], len(rolls), axis=0)
         references = [np.r_[np.zeros(space.dimension - 1), roll] for roll in rolls]
     found: list[np.ndarray] = []
     labels: list[str] = []
     reasons: list[str] = []
+    nq = space.dimension
     for pose, reference in zip(poses, references, strict=True):
         try:
             solutions = _exact_solutions(robot, pose, approach_only, reference)
@@ -206,8 +211,8 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
             q = np.asarray(solution.q, dtype=float)
             if not solution.within_limits or not np.isfinite(q).all():
                 continue
-            if any(np.allclose(q, other, atol=1e-9, rtol=0) for other in found):
-                continue
+            if found and (np.abs(np.reshape(found, (-1, nq)) - q).max(axis=1) <= 1e-9).any():
+                continue  # (a branch found before, to 1e-9 rad in every joint)
             found.append(np.clip(q, space.lower, space.upper))
             suffix = f" roll {np.degrees(q[-1]):.0f} deg" if approach_only else ""
             labels.append(f"{solution.branch}{suffix}")
