@@ -163,25 +163,31 @@ class ExactVerifier:
         configuration_poses(path, segment, parameter, self.model, self.scratch, out)
         return out
 
-    def closest(self, q: np.ndarray) -> tuple[float, int]:
-        """coal's smallest signed distance over every pair at q (nq,), in [m], and its pair
-        (inf, -1 without pairs). Branch and bound: the pairs are queried in the order of the
-        planner's tight lower bounds (one compiled call for all of them) until a positive
-        bound reaches the best exact distance (a bound <= 0 proves nothing: such a pair is
-        always queried); usually one or two coal queries instead of one per pair."""
-        config = np.ascontiguousarray(np.reshape(q, (1, -1)), dtype=float)
-        bounds = np.empty((1, len(self.pairs)))
-        poses = np.empty((1, len(self.world.links), 4, 4))
+    def closest(self, q: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """coal's smallest signed distance over every pair at each configuration of q (N, nq)
+        or (nq,), in [m], and its pair: shapes (N,), (N,) (inf, -1 without pairs).
+
+        Branch and bound: the pairs are queried in the order of the planner's tight lower
+        bounds (one compiled call for all rows) until a positive bound reaches the best exact
+        distance (a bound <= 0 proves nothing: such a pair is always queried); usually one or
+        two coal queries per configuration instead of one per pair."""
+        config = np.ascontiguousarray(np.reshape(q, (-1, self.model[9].shape[1])), dtype=float)
+        bounds = np.empty((len(config), len(self.pairs)))
+        poses = np.empty((len(config), len(self.world.links), 4, 4))
         waypoint_bounds(config, self.model, self.scratch, bounds, poses)
-        best, best_pair = np.inf, -1
-        lower = bounds[0].tolist()
-        for pair in np.argsort(bounds[0], kind="stable").tolist():
-            if lower[pair] > 0.0 and lower[pair] >= best:
-                break
-            distance = self.exact(poses[0], pair)
-            if distance < best:
-                best, best_pair = distance, pair
-        return best, best_pair
+        distances = np.full(len(config), np.inf)
+        pairs = np.full(len(config), -1, dtype=np.int64)
+        for n in range(len(config)):
+            best, best_pair = np.inf, -1
+            lower = bounds[n].tolist()
+            for pair in np.argsort(bounds[n], kind="stable").tolist():
+                if lower[pair] > 0.0 and lower[pair] >= best:
+                    break
+                distance = self.exact(poses[n], pair)
+                if distance < best:
+                    best, best_pair = distance, pair
+            distances[n], pairs[n] = best, best_pair
+        return distances, pairs
 
     def schedule(self, path: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """The rows (segment, s, pair, motion to the next row) to query exactly
@@ -367,11 +373,11 @@ def verify_path(
 def closest_contact(world: CollisionWorld, q: np.ndarray) -> tuple[float, str, str]:
     """Exact smallest signed distance at q (nq,), with its link and obstacle names, in [m]
     (:meth:`ExactVerifier.closest`: coal distances, branch and bound on the planner's bounds)."""
-    distance, pair = verifier_of(world).closest(np.asarray(q, dtype=float))
-    if pair < 0:
+    distances, pairs = verifier_of(world).closest(np.asarray(q, dtype=float))
+    if pairs[0] < 0:
         return float("inf"), "", ""
-    link, _geometry, obstacle = world.pair_names(pair)
-    return float(distance), link, obstacle
+    link, _geometry, obstacle = world.pair_names(int(pairs[0]))
+    return float(distances[0]), link, obstacle
 
 
 def require_clear(world: CollisionWorld, q: np.ndarray, what: str, clearance: float) -> float:
@@ -383,22 +389,10 @@ def require_clear(world: CollisionWorld, q: np.ndarray, what: str, clearance: fl
 
 
 def sample_clearances(world: CollisionWorld, q: np.ndarray) -> np.ndarray:
-    """Exact smallest distance over every pair at each sample (branch and bound).
-
-    Pairs whose lower bound (:meth:`CollisionWorld.lower_bounds`) is not below the best exact
-    distance found so far cannot be the minimum and are skipped.
+    """Exact smallest distance over every pair at each sample (branch and bound on the
+    planner's bounds, :meth:`ExactVerifier.closest`).
 
     q: shape (N, nq), in [rad] -> shape (N,), in [m] (inf without pairs).
     """
-    config = np.atleast_2d(np.asarray(q, dtype=float))
-    poses = world.primitive_poses(config)
-    bounds = world.lower_bounds(poses)
-    result = np.full(len(config), np.inf)
-    for n in range(len(config)):
-        best = np.inf
-        for pair in np.argsort(bounds[n]).tolist():
-            if bounds[n, pair] >= best and bounds[n, pair] > 0:
-                break
-            best = min(best, world.distance(poses[n], pair))
-        result[n] = best
-    return result
+    distances: np.ndarray = verifier_of(world).closest(np.asarray(q, dtype=float))[0]
+    return distances
