@@ -33,6 +33,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan.collision import ClearanceRecord, CollisionWorld
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
 from lynxplan.planning.certify import (
@@ -171,7 +172,7 @@ class ExactVerifier:
         bounds (one compiled call for all rows) until a positive bound reaches the best exact
         distance (a bound <= 0 proves nothing: such a pair is always queried); usually one or
         two coal queries per configuration instead of one per pair."""
-        config = np.ascontiguousarray(np.reshape(q, (-1, self.model[9].shape[1])), dtype=float)
+        config = kernel_input(np.reshape(np.asarray(q, dtype=float), (-1, self.model[9].shape[1])))
         bounds = np.empty((len(config), len(self.pairs)))
         poses = np.empty((len(config), len(self.world.links), 4, 4))
         waypoint_bounds(config, self.model, self.scratch, bounds, poses)
