@@ -55,10 +55,9 @@ from lynxplan.robots.ik.pose_kernel import (
     SLOT_COLUMNS,
     VALID,
     WITHIN,
-    YAW_MATCH,
-    YAW_MATCH_LENGTH,
     polish_pose,
     solve_target,
+    yaw_match,
 )
 
 _FAST = {"contract", "arcp"}  # fused multiply-adds, reciprocals: as in ``arm.ik_kernel``
@@ -196,13 +195,13 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
     a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
     a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
-    axial = math.sqrt(a_h * a_h + a_p * a_p) <= AXIAL_APPROACH
+    axial_size = math.sqrt(a_h * a_h + a_p * a_p)
+    axial = axial_size <= AXIAL_APPROACH
     d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
     dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
     dh = d0 * pr[F.H] + d1 * pr[F.H + 1] + d2 * pr[F.H + 2]
     dk = d0 * pr[F.K] + d1 * pr[F.K + 1] + d2 * pr[F.K + 2]
     rho = math.sqrt(dp * dp + dh * dh)
-    match = YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12)
     # the yaw that puts the approach in the arm plane, flipped by pi: its sine and cosine flip
     sign = 1.0 - 2.0 * flip
     phi = atan2(-a_p, a_h) + flip * math.pi
@@ -212,6 +211,8 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     st, ct = _roll_terms(pr, g, s_phi, c_phi, s_big, c_big)
     s_alpha, c_alpha = _unit(dh, dp)
     alpha = (atan2(dh, dp), s_alpha, c_alpha)
+    lat = pr[F.LAM4] + pr[F.W0 + 2] + ct * pr[F.E1 + 2] + st * pr[F.E2 + 2]
+    match = yaw_match(pr[F.DEVIATION], shape[0] + shape[1], axial_size, rho, lat)
     yaw0, s_yaw0, c_yaw0, lat_miss, on_axis = _yaw(pr, rho, alpha, st, ct, 0)
     yaw1, s_yaw1, c_yaw1, _, _ = _yaw(pr, rho, alpha, st, ct, 1)
     lat_ok = lat_miss <= REACH_MISS

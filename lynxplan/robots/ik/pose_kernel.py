@@ -40,12 +40,35 @@ from lynxplan.robots.ik.family_polish import (
 POSE_EXACT = 1e-9
 #: The yaw one side of the lateral offset gives must match the orientation's within this [rad],
 #: plus YAW_MATCH_LENGTH / (distance from the yaw axis) (the ideal model's tool point differs
-#: from the exact chain's by ~1e-6 m for the SO-101, which turns the yaw more near the axis).
+#: from the exact chain's by ~1e-6 m for the SO-101, which turns the yaw more near the axis),
+#: and within YAW_MATCH_DEVIATIONS times what the model's deviation from the ideal family can
+#: move it (``yaw_match``): the yaw of the other flip misses by twice the lateral offset over
+#: the distance (~4e-4 m / rho for the SO-101), the exact branches' by < 8 deviations (1e6 poses).
 YAW_MATCH, YAW_MATCH_LENGTH = 1e-3, 1e-4
+YAW_MATCH_DEVIATIONS = 30.0
+#: The deviation the yaw match assumes at least [rad] (an exact model's rounding).
+MIN_DEVIATION = 1e-9
 #: The approach this close to the yaw axis leaves the yaw to the position: root search.
 AXIAL_APPROACH = 1e-6
 #: A closed-form branch that misses the reach by more than this [m] is not polished.
 REACH_MISS = 1e-5
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def yaw_match(deviation: float, reach: float, axial: float, rho: float, lateral: float) -> float:
+    """How far [rad] the yaw one side of the lateral offset gives may miss the yaw of the
+    orientation on a branch of the exact chain: YAW_MATCH + YAW_MATCH_LENGTH / rho, and at most
+    YAW_MATCH_DEVIATIONS times what the deviation [rad] of the model from the ideal family
+    moves each: the orientation's yaw by deviation / axial (the approach's component [1] off
+    the yaw axis), the side's by deviation * reach / sqrt(rho^2 - lateral^2) (reach: the two
+    links' length [m]; rho: the target's distance from the yaw axis [m]; lateral: the lateral
+    offset at the roll [m], where the yaw turns fastest with the target)."""
+    dev = max(deviation, MIN_DEVIATION)
+    across = math.sqrt(max(rho * rho - lateral * lateral, 1e-300))
+    moved = YAW_MATCH_DEVIATIONS * dev * (1.0 / max(axial, 1e-300) + reach / across)
+    return min(YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12), moved)
+
+
 #: Gauss-Newton iterations of the polish at most, and the pose error at which it stops.
 NEWTON_STEPS = 60
 NEWTON_TOLERANCE = 1e-15
@@ -212,7 +235,10 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
         d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2],
         d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2],
     )
-    match = YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12)
+    axial = math.hypot(a_h, a_p)
+    reach = math.hypot(prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]) + math.hypot(
+        prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
+    )
     solved = False
     mode = np.int64(MODE_POSE)  # not a literal: pitch_sum and branch compile once, for every mode
     for flip in range(2):
@@ -220,6 +246,13 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
         phi = math.atan2(-a_p, a_h) + flip * math.pi
         big_phi, _ = pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
         theta = best_roll(prm, g, phi, big_phi)
+        lat = (
+            prm[F.LAM4]
+            + prm[F.W0 + 2]
+            + math.cos(theta) * prm[F.E1 + 2]
+            + math.sin(theta) * prm[F.E2 + 2]
+        )
+        match = yaw_match(prm[F.DEVIATION], reach, axial, rho, lat)
         for side in range(2):
             phi_side, lateral = yaw(prm, d0, d1, d2, theta, side, phi_ref)
             if lateral > REACH_MISS or abs(wrap(phi_side - phi)) > match:
