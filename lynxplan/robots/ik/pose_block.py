@@ -8,10 +8,11 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
 
 1. the closed form on the ideal model (yaw, pitch sum, roll, the side of the lateral offset
    whose yaw matches, the two-link shoulder and elbow);
-2. on a model only close to the family, a fixed polish on the exact chain: one Gauss-Newton step
-   (pose and geometric Jacobian, the normal equations by an LDL^T factorisation), then
-   one chord step with the same factors (from ~1e-6 away the error falls to ~1e-12, then
-   ~1e-18; candidates that start farther away get a second polish, below);
+2. on a model only close to the family, a fixed polish on the exact chain: two Gauss-Newton
+   steps (pose and geometric Jacobian, the normal equations by an LDL^T factorisation): from
+   ~1e-6 away the error falls to ~1e-12, then below rounding (a chord step in place of the
+   second left ~6 % of the SO-101's candidates above VECTOR_EXACT); candidates that start
+   farther away get a second polish, below;
 3. the angles wrapped into the joint limits, and the pose of the exact chain at the final
    angles: the position and orientation errors that are reported.
 
@@ -76,11 +77,11 @@ BLOCK = 32
 #: errors are both below this; otherwise it is rejected (below) or finished by the scalar polish.
 VECTOR_EXACT = 1e-14
 #: A candidate whose final position [m] or orientation [rad] error is above NOT_A_BRANCH and has
-#: stopped falling (at least STALLED times the error before the last chord step) is not an exact
+#: stopped falling (at least STALLED times the error before the last step) is not an exact
 #: branch: the orientation is out of reach on that flip, and the steps end at the residual of the
 #: nearest orientation (~1e-4), as the scalar polish does, which rejects it too. A candidate
-#: still falling there, or next to a fold of the elbow (where the chord steps stall before Newton's
-#: would: the roots are close), is finished by the scalar polish.
+#: still falling there, or next to a fold of the elbow (where Newton's steps converge only
+#: linearly: the roots are close), is finished by the scalar polish.
 NOT_A_BRANCH, STALLED = 1e-6, 0.5
 #: Next to a fold: |cos| of the elbow angle within this of 1 (an elbow ~0.045 rad from straight).
 FOLD_BAND = 1e-3
@@ -98,7 +99,7 @@ _PER_FLIP = 12
 _POSE_FALL = _FLIP0 + 2 * _PER_FLIP
 _ROWS = _POSE_FALL + 1
 # Candidate scratch rows (up to 4 per pose): the target (12), q (5), near a fold, the error
-# before the last chord step, then taken, fallback, within (1/0), position, orientation error,
+# before the last step, then taken, fallback, within (1/0), position, orientation error,
 # and the closed-form q (5).
 _C_Q, _C_FOLD, _C_PREV, _C_TAKE, _C_FALL, _C_IN, _C_PERR, _C_OERR = 12, 17, 18, 19, 20, 21, 22, 23
 _C_START = 24  # the closed-form q (5), where a candidate that falls back starts
@@ -418,31 +419,10 @@ def _step(
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _chord(
-    ch: Floats,
-    t: Floats,
-    lower: Floats,
-    inverse: Floats,
-    jac: tuple[Floats, ...],
-    q0: float,
-    q1: float,
-    q2: float,
-    q3: float,
-    q4: float,
-) -> Floats:
-    """One chord step: q minus the step for the pose error at q with the kept factors; and
-    the largest component of that error."""
-    e = _error(_fk(ch, q0, q1, q2, q3, q4), t)
-    size = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]), abs(e[5]))
-    x = _step(lower, inverse, jac[0], jac[1], jac[2], jac[3], jac[4], e)
-    return q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4], size
-
-
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
-    """One Gauss-Newton step and one chord step on the exact chain from q: the final q,
-    the smallest over the largest LDL^T pivot of J^T J (its conditioning), and the largest
-    component of the pose error before the chord step."""
+def _newton(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
+    """One Gauss-Newton step on the exact chain from q: the new q, the smallest over the
+    largest LDL^T pivot of J^T J (its conditioning), and the largest component of the pose
+    error at q."""
     p = _base(ch)
     o0 = _axis_of(p)
     p = _joint(ch, 0, p, q0)
@@ -457,11 +437,20 @@ def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q
     j0, j1, j2 = _column(o0, p), _column(o1, p), _column(o2, p)
     j3, j4 = _column(o3, p), _column(o4, p)
     lower, inverse, ratio = _ldl(j0, j1, j2, j3, j4)
-    x = _step(lower, inverse, j0, j1, j2, j3, j4, _error(p, t))
-    q0, q1, q2, q3, q4 = q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4]
-    jac = (j0, j1, j2, j3, j4)
-    q0, q1, q2, q3, q4, size = _chord(ch, t, lower, inverse, jac, q0, q1, q2, q3, q4)
-    return q0, q1, q2, q3, q4, ratio, size
+    e = _error(p, t)
+    size = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]), abs(e[5]))
+    x = _step(lower, inverse, j0, j1, j2, j3, j4, e)
+    return q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4], ratio, size
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
+    """Two Gauss-Newton steps on the exact chain from q: the final q, the smaller of the
+    two conditionings (``_newton``), and the largest component of the pose error before the
+    last step."""
+    q0, q1, q2, q3, q4, first, _ = _newton(ch, t, q0, q1, q2, q3, q4)
+    q0, q1, q2, q3, q4, second, size = _newton(ch, t, q0, q1, q2, q3, q4)
+    return q0, q1, q2, q3, q4, min(first, second), size
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -534,7 +523,7 @@ def _put_angles(
 def _polish_all(m: int, ch: Floats, c: np.ndarray) -> None:
     """The polish of the m candidates in the rows c (flat: row k is c[k * _CW:]; a model only
     close to the family): q in place, the fallback flag where the normal matrix is
-    ill-conditioned, the error before the last chord step."""
+    ill-conditioned, the error before the last step."""
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
         q0, q1, q2, q3, q4 = _angles_of(c, i)
@@ -582,7 +571,7 @@ def _repolish(
     m: int, pr: Floats, ch: Floats, c_flat: np.ndarray, c2_flat: np.ndarray, index: np.ndarray
 ) -> None:
     """The m candidates in the rows c_flat that the polish left unfinished next to a branch
-    (final errors below NOT_A_BRANCH: next to a fold of the elbow the chord steps converge
+    (final errors below NOT_A_BRANCH: next to a fold of the elbow the steps converge
     slowly) polished once more from where they stopped, gathered into the rows c2_flat (whole
     vectors): those that reach VECTOR_EXACT are taken, the others stay with the scalar polish
     (from their closed-form start)."""
