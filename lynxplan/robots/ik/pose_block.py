@@ -97,7 +97,8 @@ _FLIP0 = 12
 _F_Q1, _F_UP, _F_DOWN, _F_Q5, _F_CAND, _F_FALL, _F_SIDE, _F_FOLD = 0, 1, 4, 7, 8, 9, 10, 11
 _PER_FLIP = 12
 _POSE_FALL = _FLIP0 + 2 * _PER_FLIP
-_ROWS = _POSE_FALL + 1
+_PRIMARY = _POSE_FALL + 1  # the first flip that is a candidate (0/1)
+_ROWS = _PRIMARY + 1
 # Candidate scratch rows (up to 4 per pose): the target (12), q (5), near a fold, the error
 # before the last step, then taken, fallback, within (1/0), position, orientation error,
 # and the closed-form q (5).
@@ -599,6 +600,33 @@ def _repolish(
         c[_C_TAKE, k], c[_C_FALL, k] = 1.0, 0.0
 
 
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _first_flips(x: np.ndarray) -> None:
+    """The candidate lanes i (elbow up) and BLOCK + i (elbow down) of pose i's first candidate
+    flip (row _PRIMARY): the target, q and its copy, near a fold, and the flags cleared; x: the
+    scratch rows (``_closed_forms``), then the candidate rows (``_polish_all``), one flat array
+    (loops of whole vectors: the distances between the rows are constants)."""
+    c = _ROWS * BLOCK
+    for k in range(12):
+        for i in range(BLOCK):
+            x[c + k * _CW + i] = x[k * BLOCK + i]
+            x[c + k * _CW + BLOCK + i] = x[k * BLOCK + i]
+    for i in range(BLOCK):
+        second = x[_PRIMARY * BLOCK + i] != 0.0
+        one, two = _FLIP0 * BLOCK + i, (_FLIP0 + _PER_FLIP) * BLOCK + i
+        for k in range(5):
+            row = (_F_Q1, _F_UP, _F_UP + 1, _F_UP + 2, _F_Q5)[k] * BLOCK
+            up = x[two + row] if second else x[one + row]
+            row = (_F_Q1, _F_DOWN, _F_DOWN + 1, _F_DOWN + 2, _F_Q5)[k] * BLOCK
+            down = x[two + row] if second else x[one + row]
+            x[c + (_C_Q + k) * _CW + i] = x[c + (_C_START + k) * _CW + i] = up
+            x[c + (_C_Q + k) * _CW + BLOCK + i] = x[c + (_C_START + k) * _CW + BLOCK + i] = down
+        fold = x[two + _F_FOLD * BLOCK] if second else x[one + _F_FOLD * BLOCK]
+        x[c + _C_FOLD * _CW + i] = x[c + _C_FOLD * _CW + BLOCK + i] = fold
+        x[c + _C_FALL * _CW + i] = x[c + _C_FALL * _CW + BLOCK + i] = 0.0
+        x[c + _C_PREV * _CW + i] = x[c + _C_PREV * _CW + BLOCK + i] = 0.0
+
+
 @numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
     """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
@@ -669,11 +697,14 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         math.cos(gamma0),
         gamma0,
     )
-    s_flat, c_flat = np.empty(_ROWS * BLOCK), np.empty(_C_ROWS * _CW)
+    # the scratch rows and the candidate rows in one array (constant distances: ``_first_flips``)
+    x_flat = np.empty(_ROWS * BLOCK + _C_ROWS * _CW)
+    s_flat, c_flat = x_flat[: _ROWS * BLOCK], x_flat[_ROWS * BLOCK :]
     c2_flat, slot_index = np.empty(_C_ROWS * _CW), np.empty(_CW, dtype=np.int64)
     s, c = s_flat.reshape((_ROWS, BLOCK)), c_flat.reshape((_C_ROWS, _CW))
-    first = np.empty(BLOCK + 1, dtype=np.int64)  # the candidates of pose i: first[i]..first[i+1]
-    slot_of = np.empty(4 * BLOCK, dtype=np.int64)
+    owned = np.empty(BLOCK, dtype=np.int64)  # the candidates of pose i: its owned[i] lanes
+    lane_of = np.empty(4 * BLOCK, dtype=np.int64)  # lane_of[4 * i : 4 * i + owned[i]]
+    slot_of = np.empty(_CW, dtype=np.int64)
     out = np.empty((nb, SLOT_COLUMNS))
     g, pose, work = np.empty((3, 4)), np.empty((4, 4)), np.empty((4, 4))
     qs, jac, origins = np.empty(5), np.empty((6, 5)), np.empty((5, 6))
@@ -687,36 +718,45 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 for col in range(4):
                     s[4 * r + col, i] = targets[start + i, r, col]
         _closed_forms(m, pr, shape, s_flat)
-        # the candidates of the poses that need no fallback, in the scalar solver's order
-        mc = np.int64(0)  # not a literal 0: one compile of _repolish
+        # the candidates of the poses that need no fallback, in the scalar solver's order: lane
+        # i the elbow up and lane BLOCK + i the elbow down of pose i's first candidate flip (copied
+        # from the scratch rows by whole vectors), then the other flip where it is a candidate
+        # too (rare: its yaw misses by twice the lateral offset), gathered one by one
+        mc = np.int64(2 * BLOCK)  # not a literal: one compile of _repolish
         for i in range(m):
-            first[i] = mc
-            fall = False
-            for flip in range(2):
-                fall = fall or s[_FLIP0 + flip * _PER_FLIP + _F_FALL, i] != 0.0
+            fall = (s[_FLIP0 + _F_FALL, i] != 0.0) | (s[_FLIP0 + _PER_FLIP + _F_FALL, i] != 0.0)
             s[_POSE_FALL, i] = 1.0 if fall else 0.0
-            if fall:
+            cand0 = s[_FLIP0 + _F_CAND, i] != 0.0
+            cand1 = s[_FLIP0 + _PER_FLIP + _F_CAND, i] != 0.0
+            s[_PRIMARY, i] = 0.0 if cand0 else 1.0
+            owned[i] = 0
+            if fall or not (cand0 or cand1):
                 continue
             for flip in range(2):
                 base = _FLIP0 + flip * _PER_FLIP
                 if s[base + _F_CAND, i] == 0.0:
                     continue
+                side = int(s[base + _F_SIDE, i])
                 for elbow in range(2):
-                    for k in range(12):
-                        c[k, mc] = s[k, i]
-                    c[_C_Q, mc] = s[base + _F_Q1, i]
-                    for k in range(3):
-                        c[_C_Q + 1 + k, mc] = s[base + (_F_DOWN if elbow else _F_UP) + k, i]
-                    c[_C_Q + 4, mc] = s[base + _F_Q5, i]
-                    for k in range(5):
-                        c[_C_START + k, mc] = c[_C_Q + k, mc]
-                    c[_C_FOLD, mc] = s[base + _F_FOLD, i]
-                    c[_C_FALL, mc] = 0.0
-                    c[_C_PREV, mc] = 0.0
-                    side = int(s[base + _F_SIDE, i])
-                    slot_of[mc] = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
-                    mc += 1
-        first[m] = mc
+                    lane = elbow * BLOCK + i if owned[i] < 2 else mc
+                    if owned[i] >= 2:  # the second flip: gathered
+                        for k in range(12):
+                            c[k, mc] = s[k, i]
+                        c[_C_Q, mc] = s[base + _F_Q1, i]
+                        for k in range(3):
+                            c[_C_Q + 1 + k, mc] = s[base + (_F_DOWN if elbow else _F_UP) + k, i]
+                        c[_C_Q + 4, mc] = s[base + _F_Q5, i]
+                        c[_C_FOLD, mc] = s[base + _F_FOLD, i]
+                        mc += 1
+                    lane_of[4 * i + owned[i]] = lane
+                    slot_of[lane] = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
+                    owned[i] += 1
+        _first_flips(x_flat)
+        for lane in range(2 * BLOCK, mc):
+            for k in range(5):
+                c[_C_START + k, lane] = c[_C_Q + k, lane]
+            c[_C_FALL, lane] = 0.0
+            c[_C_PREV, lane] = 0.0
         # whole vectors: the lanes past the last candidate repeat the first (a remainder
         # would run through the loops' scalar epilogue, ~8 times the cost per candidate)
         lanes = min((mc + LANES - 1) // LANES * LANES, _CW)
@@ -726,6 +766,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         if not exact:
             _polish_all(lanes, ch, c_flat)
         _settle_all(lanes, pr, ch, c_flat)
+        for i in range(BLOCK):  # the lanes of no candidate (no flip, past m): nothing to finish
+            if i >= m or owned[i] == 0:
+                c[_C_FALL, i] = c[_C_FALL, BLOCK + i] = 0.0
         if not exact:
             _repolish(mc, pr, ch, c_flat, c2_flat, slot_index)
         for i in range(m):
@@ -754,7 +797,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 continue
             count = np.int64(0)  # not a literal 0: one compile of is_duplicate
             scalar = False
-            for k in range(first[i], first[i + 1]):
+            for h in range(owned[i]):
+                k = lane_of[4 * i + h]
                 b = slot_of[k]
                 if valid[n, b]:
                     continue
