@@ -73,10 +73,11 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         # the poses pose_block solves have their exact branches, each within REACH_TOLERANCE;
         # the rest (out of reach, degenerate) goes through the general kernel (root search),
         # its roots packed into the pose layout
-        rest = ~_pose_fill(robot, target, reference, out)
+        # the rows by index: a boolean mask would be scanned whole by each of the ~10 uses
+        rest = np.flatnonzero(~_pose_fill(robot, target, reference, out))
         distance = smallest_errors(out.position_error)
         reachable = np.ones(n, dtype=np.bool_)
-        if rest.any():
+        if rest.size:
             sub, ref = _rows(target, reference, rest)
             part = BranchSlots.empty(sub.poses.shape[0], 4 if slots == 4 else 4 * fk_.MAX_ROOTS)
             _kernel(robot, sub, ref, part)
@@ -101,7 +102,7 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
 
 
 def _rows(target: Target, reference: np.ndarray, mask: np.ndarray) -> tuple[Target, np.ndarray]:
-    """The targets in ``mask`` (N,) bool and their references."""
+    """The targets in ``mask`` ((N,) bool, or row indices) and their references."""
     sub = type(target)(
         np.ascontiguousarray(target.poses[mask]), target.kind, target.pitch[mask], target.roll[mask]
     )
