@@ -123,6 +123,35 @@ def test_vector_path_carries_the_load() -> None:
     assert fallbacks <= 0.01 * len(poses)
 
 
+def test_block_errors_are_pinocchio_fk_at_the_returned_angles() -> None:
+    """The vector path carries the sines and cosines of the polish through its steps and
+    through the snaps to the joint limits (Taylor series) instead of computing them afresh:
+    every branch's reported errors must still be those of Pinocchio's FK at its returned
+    angles, also where a branch lies just beyond a limit (within and past the snap
+    tolerance; a pose left with no exact branch gets its nearest orientations)."""
+    import pinocchio as pin
+
+    robot = load_robot("so101")
+    rng = np.random.default_rng(17)
+    q = robot.random_configurations(1200, seed=17)
+    lower, upper = robot.limits.lower, robot.limits.upper
+    q[:300, 2] = lower[2] + rng.uniform(-3e-4, 1e-4, 300)
+    q[300:600, 1] = upper[1] + rng.uniform(-1e-4, 3e-4, 300)
+    q[600:800, 3] = lower[3] + rng.uniform(-3e-4, 1e-4, 200)
+    poses = robot.fk(q)
+    batch = robot.ik_batch(poses)
+    assert batch.valid.any(axis=1).all()
+    for n, b in zip(*np.nonzero(batch.valid), strict=True):
+        placement = robot.frame_placement(batch.q[n, b])
+        position = np.linalg.norm(placement[:3, 3] - poses[n, :3, 3])
+        angle = np.linalg.norm(pin.log3(poses[n, :3, :3].T @ placement[:3, :3]))
+        assert position <= 1e-9
+        assert abs(position - batch.position_error[n, b]) <= 1e-14
+        assert abs(angle - batch.orientation_error[n, b]) <= 1e-14 + 1e-9 * angle
+    exact = batch.valid & (batch.orientation_error <= 1e-12)
+    assert exact.any(axis=1).mean() > 0.9
+
+
 def test_smallest_errors_skips_empty_slots() -> None:
     rng = np.random.default_rng(3)
     errors = rng.uniform(0.0, 1.0, (500, 24))

@@ -14,7 +14,10 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
    second left ~6 % of the SO-101's candidates above VECTOR_EXACT); candidates that start
    farther away get a second polish, below;
 3. the angles wrapped into the joint limits, and the pose of the exact chain at the final
-   angles: the position and orientation errors that are reported.
+   angles: the position and orientation errors that are reported. After a polish the sines
+   and cosines of the final angles are carried from those of the start through each step and
+   snap to the limits by their Taylor series (``_turn``: exact to rounding for steps up to
+   TAYLOR_STEP, the only candidates taken or rejected there), not computed afresh.
 
 A candidate is *taken* here only when its final errors are below :data:`VECTOR_EXACT` (far below
 ``POSE_EXACT``), and *rejected* (not an exact branch) when its error stopped falling far above
@@ -109,6 +112,10 @@ _CW = 4 * BLOCK  # the candidate rows' width
 #: The candidate loops run on a multiple of this many lanes (AVX-512: 8 doubles).
 LANES = 8
 _ALL_TAKEN = np.ones(4, dtype=np.bool_)
+#: The polish's steps [rad] up to which the sines and cosines of the new angles follow exactly
+#: (to rounding) from those of the old by their Taylor series (``_turn``); a candidate with a
+#: larger step is finished by the scalar polish.
+TAYLOR_STEP = 1e-3
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -271,10 +278,10 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _joint(ch: Floats, j: int, t: Floats, q: float) -> Floats:
-    """The running pose t (12: row-major 3 x 4) times R(z, q) M'_{j+1}; ch: the chain tuple
-    (``_chain_tuple``: every joint turned about its own z axis)."""
-    s, c = sincos(q)
+def _joint_turned(ch: Floats, j: int, t: Floats, s: float, c: float) -> Floats:
+    """The running pose t (12: row-major 3 x 4) times R(z, q) M'_{j+1} for the angle q of sine
+    s and cosine c; ch: the chain tuple (``_chain_tuple``: every joint turned about its own z
+    axis). j must be a literal (a constant index into ch)."""
     w00, w01 = c * t[0] + s * t[1], c * t[1] - s * t[0]
     w10, w11 = c * t[4] + s * t[5], c * t[5] - s * t[4]
     w20, w21 = c * t[8] + s * t[9], c * t[9] - s * t[8]
@@ -315,12 +322,12 @@ def _base(ch: Floats) -> Floats:
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _fk(ch: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
     """Tool pose (12: row-major 3 x 4) of the chain at q."""
-    t = _base(ch)
-    t = _joint(ch, 0, t, q0)
-    t = _joint(ch, 1, t, q1)
-    t = _joint(ch, 2, t, q2)
-    t = _joint(ch, 3, t, q3)
-    return _joint(ch, 4, t, q4)
+    s0, c0 = sincos(q0)
+    s1, c1 = sincos(q1)
+    s2, c2 = sincos(q2)
+    s3, c3 = sincos(q3)
+    s4, c4 = sincos(q4)
+    return _fk_turned(ch, (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4))
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -420,38 +427,86 @@ def _step(
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _newton(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
-    """One Gauss-Newton step on the exact chain from q: the new q, the smallest over the
-    largest LDL^T pivot of J^T J (its conditioning), and the largest component of the pose
-    error at q."""
+def _turn(s: float, c: float, x: float) -> tuple[float, float]:
+    """(sin, cos) of the angle a - x from s = sin a and c = cos a: the angle difference, with
+    sin x and cos x to fifth order (the remainder below x^6 / 720: rounding for |x| <=
+    TAYLOR_STEP)."""
+    xx = x * x
+    sx = x * (1.0 - xx * (1.0 / 6.0) * (1.0 - xx * (1.0 / 20.0)))
+    cx = 1.0 - xx * 0.5 * (1.0 - xx * (1.0 / 12.0))
+    return s * cx - c * sx, c * cx + s * sx
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
+    """One Gauss-Newton step on the exact chain from q (5), whose sines sn and cosines cs are
+    given: the step x (5; the new angles are q - x), the smallest over the largest LDL^T pivot
+    of J^T J (its conditioning), and the largest component of the pose error at q."""
     p = _base(ch)
     o0 = _axis_of(p)
-    p = _joint(ch, 0, p, q0)
+    p = _joint_turned(ch, 0, p, sn[0], cs[0])
     o1 = _axis_of(p)
-    p = _joint(ch, 1, p, q1)
+    p = _joint_turned(ch, 1, p, sn[1], cs[1])
     o2 = _axis_of(p)
-    p = _joint(ch, 2, p, q2)
+    p = _joint_turned(ch, 2, p, sn[2], cs[2])
     o3 = _axis_of(p)
-    p = _joint(ch, 3, p, q3)
+    p = _joint_turned(ch, 3, p, sn[3], cs[3])
     o4 = _axis_of(p)
-    p = _joint(ch, 4, p, q4)
+    p = _joint_turned(ch, 4, p, sn[4], cs[4])
     j0, j1, j2 = _column(o0, p), _column(o1, p), _column(o2, p)
     j3, j4 = _column(o3, p), _column(o4, p)
     lower, inverse, ratio = _ldl(j0, j1, j2, j3, j4)
     e = _error(p, t)
     size = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]), abs(e[5]))
     x = _step(lower, inverse, j0, j1, j2, j3, j4, e)
-    return q0 - x[0], q1 - x[1], q2 - x[2], q3 - x[3], q4 - x[4], ratio, size
+    return x[0], x[1], x[2], x[3], x[4], ratio, size
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _polish(ch: Floats, t: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Floats:
-    """Two Gauss-Newton steps on the exact chain from q: the final q, the smaller of the
-    two conditionings (``_newton``), and the largest component of the pose error before the
-    last step."""
-    q0, q1, q2, q3, q4, first, _ = _newton(ch, t, q0, q1, q2, q3, q4)
-    q0, q1, q2, q3, q4, second, size = _newton(ch, t, q0, q1, q2, q3, q4)
-    return q0, q1, q2, q3, q4, min(first, second), size
+def _polish(ch: Floats, t: Floats, q: Floats) -> tuple[Floats, Floats, Floats, float, float, bool]:
+    """Two Gauss-Newton steps on the exact chain from q (5): the final q, its sines and
+    cosines, the smaller of the two conditionings (``_newton``), the largest component of the
+    pose error before the last step, and whether both steps were within TAYLOR_STEP.
+
+    The sines and cosines of the start come from ``sincos``; those after each step from the
+    ones before it (``_turn``): exact to rounding where the steps are small (trusted), and
+    still good enough for the second step's direction where they are not."""
+    s0, c0 = sincos(q[0])
+    s1, c1 = sincos(q[1])
+    s2, c2 = sincos(q[2])
+    s3, c3 = sincos(q[3])
+    s4, c4 = sincos(q[4])
+    sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
+    x0, x1, x2, x3, x4, first, _ = _newton(ch, t, q, sn, cs)
+    big = max(abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
+    q = (q[0] - x0, q[1] - x1, q[2] - x2, q[3] - x3, q[4] - x4)
+    s0, c0 = _turn(s0, c0, x0)
+    s1, c1 = _turn(s1, c1, x1)
+    s2, c2 = _turn(s2, c2, x2)
+    s3, c3 = _turn(s3, c3, x3)
+    s4, c4 = _turn(s4, c4, x4)
+    sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
+    x0, x1, x2, x3, x4, second, size = _newton(ch, t, q, sn, cs)
+    big = max(big, abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
+    q = (q[0] - x0, q[1] - x1, q[2] - x2, q[3] - x3, q[4] - x4)
+    s0, c0 = _turn(s0, c0, x0)
+    s1, c1 = _turn(s1, c1, x1)
+    s2, c2 = _turn(s2, c2, x2)
+    s3, c3 = _turn(s3, c3, x3)
+    s4, c4 = _turn(s4, c4, x4)
+    sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
+    return q, sn, cs, min(first, second), size, big <= TAYLOR_STEP
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _fk_turned(ch: Floats, sn: Floats, cs: Floats) -> Floats:
+    """Tool pose (12: row-major 3 x 4) of the chain at the angles of sines sn and cosines cs."""
+    t = _base(ch)
+    t = _joint_turned(ch, 0, t, sn[0], cs[0])
+    t = _joint_turned(ch, 1, t, sn[1], cs[1])
+    t = _joint_turned(ch, 2, t, sn[2], cs[2])
+    t = _joint_turned(ch, 3, t, sn[3], cs[3])
+    return _joint_turned(ch, 4, t, sn[4], cs[4])
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -520,49 +575,92 @@ def _put_angles(
     c[b], c[b + _CW], c[b + 2 * _CW], c[b + 3 * _CW], c[b + 4 * _CW] = q0, q1, q2, q3, q4
 
 
-@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
-def _polish_all(m: int, ch: Floats, c: np.ndarray) -> None:
-    """The polish of the m candidates in the rows c (flat: row k is c[k * _CW:]; a model only
-    close to the family): q in place, the fallback flag where the normal matrix is
-    ill-conditioned, the error before the last step."""
-    for i in range(m):
-        t = _column_of(c, _CW, 0, i)
-        q0, q1, q2, q3, q4 = _angles_of(c, i)
-        q0, q1, q2, q3, q4, ratio, size = _polish(ch, t, q0, q1, q2, q3, q4)
-        _put_angles(c, i, q0, q1, q2, q3, q4)
-        c[_C_FALL * _CW + i] = 0.0 if ratio >= ILL_CONDITIONED else 1.0
-        c[_C_PREV * _CW + i] = size
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _wrapped(pr: Floats, q: Floats) -> Floats:
+    """The angles q (5) wrapped into the limits (``wrap_into_limits``), and whether all are
+    within them (1/0)."""
+    tol = pr[F.LIMIT_TOL]
+    lo = (pr[F.LOWER], pr[F.LOWER + 1], pr[F.LOWER + 2], pr[F.LOWER + 3], pr[F.LOWER + 4])
+    hi = (pr[F.UPPER], pr[F.UPPER + 1], pr[F.UPPER + 2], pr[F.UPPER + 3], pr[F.UPPER + 4])
+    q0, in0 = wrap_into_limits(q[0], lo[0], hi[0], tol)
+    q1, in1 = wrap_into_limits(q[1], lo[1], hi[1], tol)
+    q2, in2 = wrap_into_limits(q[2], lo[2], hi[2], tol)
+    q3, in3 = wrap_into_limits(q[3], lo[3], hi[3], tol)
+    q4, in4 = wrap_into_limits(q[4], lo[4], hi[4], tol)
+    return q0, q1, q2, q3, q4, 1.0 if in0 & in1 & in2 & in3 & in4 else 0.0
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _snap(q: float, w: float) -> float:
+    """The angle [rad] between q and its wrapped w, less whole turns: what the limits snapped."""
+    d = q - w
+    return d - math.floor(d * (0.5 / math.pi) + 0.5) * (2.0 * math.pi)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _verdict(t: Floats, p: Floats, prev: float, fold: float) -> Floats:
+    """A candidate's position and orientation errors from its pose p on the exact chain at its
+    final angles, taken (1/0), and whether it is not a branch (1/0: its error is above
+    NOT_A_BRANCH and stopped falling, from prev before the last step, away from a fold (fold
+    0); see the module docstring)."""
+    dx, dy, dz = p[3] - t[3], p[7] - t[7], p[11] - t[11]
+    err = math.sqrt(dx * dx + dy * dy + dz * dz)
+    angle = _rotation_angle(p, t)
+    good = (err <= VECTOR_EXACT) & (angle <= VECTOR_EXACT)
+    final = max(err, angle)
+    far = (final > NOT_A_BRANCH) & (final >= STALLED * prev) & (fold == 0.0)
+    return err, angle, 1.0 if good else 0.0, 1.0 if far else 0.0
 
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
 def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
-    """The m candidates' angles wrapped into the limits, their errors at the final angles, and
-    the verdict: taken, fallback (see the module docstring), or neither (not a branch)."""
-    tol = pr[F.LIMIT_TOL]
-    lo = (pr[F.LOWER], pr[F.LOWER + 1], pr[F.LOWER + 2], pr[F.LOWER + 3], pr[F.LOWER + 4])
-    hi = (pr[F.UPPER], pr[F.UPPER + 1], pr[F.UPPER + 2], pr[F.UPPER + 3], pr[F.UPPER + 4])
+    """The m candidates in the rows c (flat: row k is c[k * _CW:]) as they are (an exact model
+    of the family: no polish), wrapped into the limits, and the verdict (``_verdict``) at the
+    final angles: taken, fallback (see the module docstring), or neither (not a branch)."""
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
-        q0, q1, q2, q3, q4 = _angles_of(c, i)
-        q0, in0 = wrap_into_limits(q0, lo[0], hi[0], tol)
-        q1, in1 = wrap_into_limits(q1, lo[1], hi[1], tol)
-        q2, in2 = wrap_into_limits(q2, lo[2], hi[2], tol)
-        q3, in3 = wrap_into_limits(q3, lo[3], hi[3], tol)
-        q4, in4 = wrap_into_limits(q4, lo[4], hi[4], tol)
+        q0, q1, q2, q3, q4, inside = _wrapped(pr, _angles_of(c, i))
         p = _fk(ch, q0, q1, q2, q3, q4)
-        dx, dy, dz = p[3] - t[3], p[7] - t[7], p[11] - t[11]
-        err = math.sqrt(dx * dx + dy * dy + dz * dz)
-        angle = _rotation_angle(p, t)
-        good = (err <= VECTOR_EXACT) & (angle <= VECTOR_EXACT)
-        final = max(err, angle)
-        stalled = (final >= STALLED * c[_C_PREV * _CW + i]) & (c[_C_FOLD * _CW + i] == 0.0)
-        far = (final > NOT_A_BRANCH) & stalled
+        prev, fold = c[_C_PREV * _CW + i], c[_C_FOLD * _CW + i]
+        err, angle, good, far = _verdict(t, p, prev, fold)
         _put_angles(c, i, q0, q1, q2, q3, q4)
-        c[_C_TAKE * _CW + i] = 1.0 if good else 0.0
-        c[_C_FALL * _CW + i] = (
-            1.0 if (c[_C_FALL * _CW + i] != 0.0) | ((not good) & (not far)) else 0.0
-        )
-        c[_C_IN * _CW + i] = 1.0 if in0 & in1 & in2 & in3 & in4 else 0.0
+        c[_C_TAKE * _CW + i] = good
+        c[_C_FALL * _CW + i] = 1.0 if (good == 0.0) & (far == 0.0) else 0.0
+        c[_C_IN * _CW + i] = inside
+        c[_C_PERR * _CW + i] = err
+        c[_C_OERR * _CW + i] = angle
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
+    """The polish (``_polish``) of the m candidates in the rows c (flat: row k is c[k * _CW:];
+    a model only close to the family), the error before its last step, the angles wrapped into
+    the limits, and the verdict (``_verdict``) at the final angles, whose sines and cosines
+    follow from the polish's by what the limits snapped (``_turn``): only where every step
+    and snap is within TAYLOR_STEP is a candidate taken or found not to be a branch (an
+    ill-conditioned polish also leaves it to the scalar one)."""
+    for i in range(m):
+        t = _column_of(c, _CW, 0, i)
+        q, sn, cs, ratio, size, sure = _polish(ch, t, _angles_of(c, i))
+        w0, w1, w2, w3, w4, inside = _wrapped(pr, q)
+        r0, r1, r2 = _snap(q[0], w0), _snap(q[1], w1), _snap(q[2], w2)
+        r3, r4 = _snap(q[3], w3), _snap(q[4], w4)
+        s0, c0 = _turn(sn[0], cs[0], r0)
+        s1, c1 = _turn(sn[1], cs[1], r1)
+        s2, c2 = _turn(sn[2], cs[2], r2)
+        s3, c3 = _turn(sn[3], cs[3], r3)
+        s4, c4 = _turn(sn[4], cs[4], r4)
+        p = _fk_turned(ch, (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4))
+        sure &= max(abs(r0), abs(r1), abs(r2), abs(r3), abs(r4)) <= TAYLOR_STEP
+        err, angle, good, far = _verdict(t, p, size, c[_C_FOLD * _CW + i])
+        good = good if sure else 0.0
+        far = far if sure else 0.0
+        _put_angles(c, i, w0, w1, w2, w3, w4)
+        c[_C_PREV * _CW + i] = size
+        c[_C_TAKE * _CW + i] = good
+        fall = (ratio < ILL_CONDITIONED) | ((good == 0.0) & (far == 0.0))
+        c[_C_FALL * _CW + i] = 1.0 if fall else 0.0
+        c[_C_IN * _CW + i] = inside
         c[_C_PERR * _CW + i] = err
         c[_C_OERR * _CW + i] = angle
 
@@ -589,8 +687,7 @@ def _repolish(
         k = index[min(j, count - 1)]
         for row in range(_C_ROWS):
             c2[row, j] = c[row, k]
-    _polish_all(lanes, ch, c2_flat)
-    _settle_all(lanes, pr, ch, c2_flat)
+    _polish_settle_all(lanes, pr, ch, c2_flat)
     for j in range(count):
         if c2[_C_TAKE, j] == 0.0:
             continue
@@ -603,9 +700,9 @@ def _repolish(
 @numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
 def _first_flips(x: np.ndarray) -> None:
     """The candidate lanes i (elbow up) and BLOCK + i (elbow down) of pose i's first candidate
-    flip (row _PRIMARY): the target, q and its copy, near a fold, and the flags cleared; x: the
-    scratch rows (``_closed_forms``), then the candidate rows (``_polish_all``), one flat array
-    (loops of whole vectors: the distances between the rows are constants)."""
+    flip (row _PRIMARY): the target, q and its copy, near a fold, and the flags cleared; x:
+    the scratch rows (``_closed_forms``), then the candidate rows (``_polish_settle_all``), one
+    flat array (loops of whole vectors: the distances between the rows are constants)."""
     c = _ROWS * BLOCK
     for k in range(12):
         for i in range(BLOCK):
@@ -763,9 +860,10 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         for lane in range(mc, lanes):
             for k in range(_C_ROWS):
                 c[k, lane] = c[k, 0]
-        if not exact:
-            _polish_all(lanes, ch, c_flat)
-        _settle_all(lanes, pr, ch, c_flat)
+        if exact:
+            _settle_all(lanes, pr, ch, c_flat)
+        else:
+            _polish_settle_all(lanes, pr, ch, c_flat)
         for i in range(BLOCK):  # the lanes of no candidate (no flip, past m): nothing to finish
             if i >= m or owned[i] == 0:
                 c[_C_FALL, i] = c[_C_FALL, BLOCK + i] = 0.0
