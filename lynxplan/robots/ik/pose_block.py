@@ -17,7 +17,7 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
    angles: the position and orientation errors that are reported. After a polish the sines
    and cosines of the final angles are carried from those of the start through each step and
    snap to the limits by their Taylor series (``_turn``: exact to rounding for steps up to
-   TAYLOR_STEP, the only candidates taken or rejected there), not computed afresh.
+   TAYLOR_STEP, the only candidates taken there), not computed afresh.
 
 A candidate is *taken* here only when its final errors are below :data:`VECTOR_EXACT` (far below
 ``POSE_EXACT``), and *rejected* (not an exact branch) when its error stopped falling far above
@@ -116,6 +116,9 @@ _ALL_TAKEN = np.ones(4, dtype=np.bool_)
 #: (to rounding) from those of the old by their Taylor series (``_turn``); a candidate with a
 #: larger step is finished by the scalar polish.
 TAYLOR_STEP = 1e-3
+#: ... and up to which a candidate may be found not to be a branch: there the sines and cosines
+#: are within FAR_STEP^6 / 720 (1.4e-9) of the exact ones, far below NOT_A_BRANCH.
+FAR_STEP = 0.1
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -463,13 +466,13 @@ def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _polish(ch: Floats, t: Floats, q: Floats) -> tuple[Floats, Floats, Floats, float, float, bool]:
+def _polish(ch: Floats, t: Floats, q: Floats) -> tuple[Floats, Floats, Floats, float, float, float]:
     """Two Gauss-Newton steps on the exact chain from q (5): the final q, its sines and
     cosines, the smaller of the two conditionings (``_newton``), the largest component of the
-    pose error before the last step, and whether both steps were within TAYLOR_STEP.
+    pose error before the last step, and the largest step [rad] of either.
 
     The sines and cosines of the start come from ``sincos``; those after each step from the
-    ones before it (``_turn``): exact to rounding where the steps are small (trusted), and
+    ones before it (``_turn``): exact to rounding where the steps are within TAYLOR_STEP, and
     still good enough for the second step's direction where they are not."""
     s0, c0 = sincos(q[0])
     s1, c1 = sincos(q[1])
@@ -495,7 +498,7 @@ def _polish(ch: Floats, t: Floats, q: Floats) -> tuple[Floats, Floats, Floats, f
     s3, c3 = _turn(s3, c3, x3)
     s4, c4 = _turn(s4, c4, x4)
     sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
-    return q, sn, cs, min(first, second), size, big <= TAYLOR_STEP
+    return q, sn, cs, min(first, second), size, big
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -637,11 +640,11 @@ def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     a model only close to the family), the error before its last step, the angles wrapped into
     the limits, and the verdict (``_verdict``) at the final angles, whose sines and cosines
     follow from the polish's by what the limits snapped (``_turn``): only where every step
-    and snap is within TAYLOR_STEP is a candidate taken or found not to be a branch (an
-    ill-conditioned polish also leaves it to the scalar one)."""
+    and snap is within TAYLOR_STEP is a candidate taken, within FAR_STEP found not to be a
+    branch; the others, and an ill-conditioned polish, are left to the second polish."""
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
-        q, sn, cs, ratio, size, sure = _polish(ch, t, _angles_of(c, i))
+        q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i))
         w0, w1, w2, w3, w4, inside = _wrapped(pr, q)
         r0, r1, r2 = _snap(q[0], w0), _snap(q[1], w1), _snap(q[2], w2)
         r3, r4 = _snap(q[3], w3), _snap(q[4], w4)
@@ -651,10 +654,10 @@ def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
         s3, c3 = _turn(sn[3], cs[3], r3)
         s4, c4 = _turn(sn[4], cs[4], r4)
         p = _fk_turned(ch, (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4))
-        sure &= max(abs(r0), abs(r1), abs(r2), abs(r3), abs(r4)) <= TAYLOR_STEP
+        big = max(big, abs(r0), abs(r1), abs(r2), abs(r3), abs(r4))
         err, angle, good, far = _verdict(t, p, size, c[_C_FOLD * _CW + i])
-        good = good if sure else 0.0
-        far = far if sure else 0.0
+        good = good if big <= TAYLOR_STEP else 0.0
+        far = far if big <= FAR_STEP else 0.0
         _put_angles(c, i, w0, w1, w2, w3, w4)
         c[_C_PREV * _CW + i] = size
         c[_C_TAKE * _CW + i] = good

@@ -57,16 +57,19 @@ REACH_MISS = 1e-5
 @numba.njit(cache=True, nogil=True, inline="always")
 def yaw_match(deviation: float, reach: float, axial: float, rho: float, lateral: float) -> float:
     """How far [rad] the yaw one side of the lateral offset gives may miss the yaw of the
-    orientation on a branch of the exact chain: YAW_MATCH + YAW_MATCH_LENGTH / rho, and at most
-    YAW_MATCH_DEVIATIONS times what the deviation [rad] of the model from the ideal family
-    moves each: the orientation's yaw by deviation / axial (the approach's component [1] off
-    the yaw axis), the side's by deviation * reach / sqrt(rho^2 - lateral^2) (reach: the two
-    links' length [m]; rho: the target's distance from the yaw axis [m]; lateral: the lateral
-    offset at the roll [m], where the yaw turns fastest with the target)."""
+    orientation on a branch of the exact chain: at most YAW_MATCH_DEVIATIONS times what the
+    deviation [rad] of the model from the ideal family moves each: the orientation's yaw by
+    deviation / axial (the approach's component [1] off the yaw axis), the side's by
+    deviation * reach / sqrt(rho^2 - lateral^2) (reach: the two links' length [m]; rho: the
+    target's distance from the yaw axis [m]; lateral: the lateral offset at the roll [m],
+    where the yaw turns fastest with the target); and at most YAW_MATCH + YAW_MATCH_LENGTH /
+    rho, YAW_MATCH raised to the orientation's part for an approach near the yaw axis (whose
+    poses the general kernel's root search would otherwise take, ~30 us each)."""
     dev = max(deviation, MIN_DEVIATION)
     across = math.sqrt(max(rho * rho - lateral * lateral, 1e-300))
-    moved = YAW_MATCH_DEVIATIONS * dev * (1.0 / max(axial, 1e-300) + reach / across)
-    return min(YAW_MATCH + YAW_MATCH_LENGTH / max(rho, 1e-12), moved)
+    axial_part = YAW_MATCH_DEVIATIONS * dev / max(axial, 1e-300)
+    moved = axial_part + YAW_MATCH_DEVIATIONS * dev * reach / across
+    return min(max(YAW_MATCH, axial_part) + YAW_MATCH_LENGTH / max(rho, 1e-12), moved)
 
 
 #: Gauss-Newton iterations of the polish at most, and the pose error at which it stops.
