@@ -43,7 +43,12 @@ from lynxplan.planning.edge_walk import (
     state_slacks,
 )
 from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
-from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
+from lynxplan.planning.validity import (
+    ValidityChecker,
+    point_is_clear,
+    probes_are_clear,
+    state_bounds,
+)
 
 #: Kernel status codes.
 RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2
@@ -318,10 +323,11 @@ def straight_goal(
     start: np.ndarray, goals: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> int:
     """The first goal (K, nq) whose straight edge from start (nq,) is certified, or -1 (a
-    blocked edge is usually blocked at its midpoint: that quick test first)."""
+    blocked edge is usually blocked at a quarter or its midpoint: those quick tests first,
+    :func:`lynxplan.planning.validity.probes_are_clear`)."""
     for k in range(goals.shape[0]):
-        if point_is_clear(
-            start, goals[k], 0.5, model, scratch, clearance
+        if probes_are_clear(
+            start, goals[k], model, scratch, clearance
         ) and edge_is_free_after_midpoint(start, goals[k], model, scratch, clearance):
             return k
     return -1

@@ -43,7 +43,12 @@ from lynxplan.planning.edge_walk import (
     edge_is_free_after_midpoint,
 )
 from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
-from lynxplan.planning.validity import ValidityChecker, point_is_clear, state_bounds
+from lynxplan.planning.validity import (
+    ValidityChecker,
+    point_is_clear,
+    probes_are_clear,
+    state_bounds,
+)
 
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
@@ -118,7 +123,7 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
     while i < count - 1:
         j = count - 1
         while j > i + 1:
-            if point_is_clear(path[i], path[j], 0.5, model, scratch, clearance):
+            if probes_are_clear(path[i], path[j], model, scratch, clearance):
                 start = _slacks_at(path, i, slacks, known, model, scratch, clearance)
                 end = _slacks_at(path, j, slacks, known, model, scratch, clearance)
                 reached = edge_fraction_from(
@@ -212,7 +217,7 @@ def _full(
     i2 = _point_at(path, cumulative, count, u2, second)
     if i1 == i2 or count + 2 > path.shape[0]:
         return 0
-    if not point_is_clear(first, second, 0.5, model, scratch, clearance) or (
+    if not probes_are_clear(first, second, model, scratch, clearance) or (
         not edge_is_free_after_midpoint(first, second, model, scratch, clearance)
     ):
         return 0
@@ -451,8 +456,8 @@ def shortcut_kernel(
             count, idle = size, 0
     k = 1
     while k < count - 1:
-        if point_is_clear(
-            path[k - 1], path[k + 1], 0.5, model, scratch, clearance
+        if probes_are_clear(
+            path[k - 1], path[k + 1], model, scratch, clearance
         ) and edge_is_free_after_midpoint(path[k - 1], path[k + 1], model, scratch, clearance):
             for m in range(k, count - 1):
                 path[m] = path[m + 1]
