@@ -896,6 +896,24 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     position_error[n, b] = out[b, POSITION_ERROR]
                     orientation_error[n, b] = out[b, ORIENTATION_ERROR]
                 continue
+            if owned[i] == 2:  # the common case: both elbows of one flip, both taken
+                ka, kb = lane_of[4 * i], lane_of[4 * i + 1]
+                both = (c[_C_TAKE, ka] != 0.0) & (c[_C_TAKE, kb] != 0.0)
+                if both & (c[_C_FALL, ka] == 0.0) & (c[_C_FALL, kb] == 0.0):
+                    gap = 0.0
+                    for j in range(5):
+                        gap = max(gap, abs(c[_C_Q + j, ka] - c[_C_Q + j, kb]))
+                    for h in range(2 if gap >= DUPLICATE_TOLERANCE else 1):  # kb: a duplicate?
+                        k = kb if h else ka
+                        b = slot_of[k]
+                        for j in range(5):
+                            q_out[n, b, j] = c[_C_Q + j, k]
+                        valid[n, b] = True
+                        within[n, b] = c[_C_IN, k] != 0.0
+                        position_error[n, b] = c[_C_PERR, k]
+                        orientation_error[n, b] = c[_C_OERR, k]
+                    solved[n] = True
+                    continue
             count = np.int64(0)  # not a literal 0: one compile of is_duplicate
             scalar = False
             for h in range(owned[i]):
