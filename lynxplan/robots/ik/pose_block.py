@@ -823,15 +823,25 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         # from the scratch rows by whole vectors), then the other flip where it is a candidate
         # too (rare: its yaw misses by twice the lateral offset), gathered one by one
         mc = np.int64(2 * BLOCK)  # not a literal: one compile of _repolish
-        for i in range(m):
+        second_flips = False
+        for i in range(m):  # by selects: the first flip's lanes and slots
             fall = (s[_FLIP0 + _F_FALL, i] != 0.0) | (s[_FLIP0 + _PER_FLIP + _F_FALL, i] != 0.0)
-            s[_POSE_FALL, i] = 1.0 if fall else 0.0
             cand0 = s[_FLIP0 + _F_CAND, i] != 0.0
             cand1 = s[_FLIP0 + _PER_FLIP + _F_CAND, i] != 0.0
+            s[_POSE_FALL, i] = 1.0 if fall else 0.0
             s[_PRIMARY, i] = 0.0 if cand0 else 1.0
-            owned[i] = 0
-            if fall or not (cand0 or cand1):
+            owned[i] = 2 if (not fall) and (cand0 or cand1) else 0
+            second_flips = second_flips or ((not fall) and cand0 and cand1)
+            base = _FLIP0 + (0 if cand0 else _PER_FLIP)
+            side = s[base + _F_SIDE, i]
+            slot = int(side) * per_side + (0 if cand0 or per_side <= 2 else 2)
+            lane_of[4 * i], lane_of[4 * i + 1] = i, BLOCK + i
+            slot_of[i], slot_of[BLOCK + i] = slot, slot + 1
+        for i in range(m if second_flips else 0):  # the second candidate flips: gathered
+            fall = s[_POSE_FALL, i] != 0.0
+            if fall or s[_FLIP0 + _F_CAND, i] == 0.0 or s[_FLIP0 + _PER_FLIP + _F_CAND, i] == 0.0:
                 continue
+            owned[i] = 0
             for flip in range(2):
                 base = _FLIP0 + flip * _PER_FLIP
                 if s[base + _F_CAND, i] == 0.0:
