@@ -111,22 +111,29 @@ def _read_text(path: Path, max_bytes: int) -> str:
 
 
 def _check_events(path: Path, text: str, max_depth: int, max_events: int) -> None:
-    """Walk the parser's events (iterative, no recursion): depth and count limits."""
+    """Walk the parser's events (iterative, no recursion): depth and count limits.
+
+    libyaml (PyYAML >= 6.0.4) has a nesting limit of its own (about 1000 levels), which its
+    scanner may reach while it looks ahead, before the events reach ``max_depth``: that error
+    is the same "nesting deeper" error."""
     depth = 0
-    for events, event in enumerate(yaml.parse(text, Loader=_BaseLoader), start=1):
-        line = _line(event)
-        if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
-            depth += 1
-            if depth > max_depth:
-                raise _error(
-                    path,
-                    f"nesting deeper than {max_depth} levels",
-                    line,
-                )
-        elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
-            depth -= 1
-        if events > max_events:
-            raise _error(path, f"more than {max_events} YAML elements", line)
+    try:
+        for events, event in enumerate(yaml.parse(text, Loader=_BaseLoader), start=1):
+            line = _line(event)
+            if isinstance(event, (yaml.MappingStartEvent, yaml.SequenceStartEvent)):
+                depth += 1
+                if depth > max_depth:
+                    raise _error(path, f"nesting deeper than {max_depth} levels", line)
+            elif isinstance(event, (yaml.MappingEndEvent, yaml.SequenceEndEvent)):
+                depth -= 1
+            if events > max_events:
+                raise _error(path, f"more than {max_events} YAML elements", line)
+    except yaml.YAMLError as exc:
+        if "nesting depth" not in str(getattr(exc, "problem", "")):
+            raise
+        mark = getattr(exc, "problem_mark", None)
+        line = None if mark is None else mark.line + 1
+        raise _error(path, f"nesting deeper than {max_depth} levels", line) from None
 
 
 def _expanded_size(path: Path, root: yaml.Node, limit: int) -> int:
