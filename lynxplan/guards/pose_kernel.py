@@ -32,8 +32,47 @@ def pose_check_kernel(T: np.ndarray, max_length: float, approach_only: bool) -> 
 def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.ndarray:
     """First bad pose of ``T`` (N, 4, 4): ``[index, code, detail]``; code 0: all good, and the
     detail is then the largest deviation of a rotation block from orthonormal (0 with
-    ``approach_only``)."""
+    ``approach_only``).
+
+    A first pass without early exits (vectorised) checks every pose; only when one fails does
+    the second pass look for the first bad one."""
     out = np.zeros(3)
+    good = True
+    worst = 0.0
+    for k in range(T.shape[0]):
+        t = T[k]
+        r0 = (t[0, 0] + t[0, 1]) + (t[0, 2] + t[0, 3])
+        r1 = (t[1, 0] + t[1, 1]) + (t[1, 2] + t[1, 3])
+        r2 = (t[2, 0] + t[2, 1]) + (t[2, 2] + t[2, 3])
+        r3 = (t[3, 0] + t[3, 1]) + (t[3, 2] + t[3, 3])
+        nan = ((r0 + r1) + (r2 + r3)) * 0.0  # NaN when an element is not finite
+        far = max(abs(t[0, 3]), abs(t[1, 3]), abs(t[2, 3]))
+        bottom = max(abs(t[3, 0]), abs(t[3, 1]), abs(t[3, 2]), abs(t[3, 3] - 1.0))
+        if approach_only:
+            deviation = abs(t[0, 2] ** 2 + t[1, 2] ** 2 + t[2, 2] ** 2 - 1.0)
+            det = 1.0
+        else:
+            deviation = 0.0
+            for i in range(3):
+                for j in range(i, 3):  # R^T R is symmetric
+                    dot = t[0, i] * t[0, j] + t[1, i] * t[1, j] + t[2, i] * t[2, j]
+                    deviation = max(deviation, abs(dot - (1.0 if i == j else 0.0)))
+            det = (
+                t[0, 0] * (t[1, 1] * t[2, 2] - t[1, 2] * t[2, 1])
+                - t[0, 1] * (t[1, 0] * t[2, 2] - t[1, 2] * t[2, 0])
+                + t[0, 2] * (t[1, 0] * t[2, 1] - t[1, 1] * t[2, 0])
+            )
+            worst = max(worst, deviation)
+        good &= (
+            (nan == 0.0)
+            & (far <= max_length)
+            & (bottom <= 1e-9)
+            & (deviation <= RIGIDITY_REPAIR_TOLERANCE)
+            & (det >= 0.0)
+        )
+    if good:
+        out[2] = worst
+        return out
     worst = 0.0
     for k in range(T.shape[0]):
         t = T[k]

@@ -572,3 +572,40 @@ def test_functional_api_refuses_bad_dtypes_and_nan_reference() -> None:
         solve_ik_batch("x")
     with pytest.raises(NonFiniteInputError, match=r"q_reference"):
         solve_ik_batch(T0, q_reference=[0, 0, 0, 0, math.nan])  # one (5,) reference too
+
+
+def test_pose_check_finds_the_first_bad_pose_of_a_batch() -> None:
+    """The pose check's fast pass (no early exit) and its scan agree: each kind of bad pose,
+    alone or after another, is reported at its index with its code; a good batch reports the
+    largest deviation from orthonormal (numpy's max |R^T R - I|)."""
+    from scipy.spatial.transform import Rotation
+
+    from lynxplan.guards import pose_kernel as pk
+
+    n = 500
+    good = np.zeros((n, 4, 4))
+    good[:, :3, :3] = Rotation.random(n, random_state=5).as_matrix()
+    good[:, :3, 3] = 0.2
+    good[:, 3, 3] = 1.0
+    gram = np.einsum("nji,njk->nik", good[:, :3, :3], good[:, :3, :3]) - np.eye(3)
+    for approach in (False, True):
+        k, code, detail = pk.pose_check_kernel(good, 10.0, approach)
+        assert (k, code) == (0, pk.POSE_OK)
+        assert detail == (0.0 if approach else pytest.approx(np.abs(gram).max(), rel=1e-12))
+    breaks = {
+        pk.POSE_NON_FINITE: lambda t: t.__setitem__((1, 2), np.inf),
+        pk.POSE_FAR: lambda t: t.__setitem__((0, 3), 11.0),
+        pk.POSE_BOTTOM_ROW: lambda t: t.__setitem__((3, 1), 1e-6),
+        pk.POSE_NOT_ORTHONORMAL: lambda t: t.__setitem__((0, 2), t[0, 2] + 0.1),
+        pk.POSE_REFLECTION: lambda t: t.__setitem__(slice(None, 3, None), -t[:3]),
+    }
+    rng = np.random.default_rng(8)
+    for code, spoil in breaks.items():
+        for trial in range(6):
+            batch = good.copy()
+            at = int(rng.integers(n - 1))
+            spoil(batch[at])
+            if trial % 2:
+                batch[at + 1, 0, 0] = np.nan  # a later bad pose is not reported
+            got = pk.pose_check_kernel(batch, 10.0, False)
+            assert (int(got[0]), int(got[1])) == (at, code)
