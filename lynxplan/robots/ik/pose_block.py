@@ -441,6 +441,21 @@ def _turn(s: float, c: float, x: float) -> tuple[float, float]:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _stepped(q: Floats, sn: Floats, cs: Floats, x: Floats) -> tuple[Floats, Floats, Floats]:
+    """The angles q - x (5) and their sines and cosines turned from sn, cs (:func:`_turn`)."""
+    s0, c0 = _turn(sn[0], cs[0], x[0])
+    s1, c1 = _turn(sn[1], cs[1], x[1])
+    s2, c2 = _turn(sn[2], cs[2], x[2])
+    s3, c3 = _turn(sn[3], cs[3], x[3])
+    s4, c4 = _turn(sn[4], cs[4], x[4])
+    return (
+        (q[0] - x[0], q[1] - x[1], q[2] - x[2], q[3] - x[3], q[4] - x[4]),
+        (s0, s1, s2, s3, s4),
+        (c0, c1, c2, c3, c4),
+    )
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
     """One Gauss-Newton step on the exact chain from q (5), whose sines sn and cosines cs are
     given: the step x (5; the new angles are q - x), the smallest over the largest LDL^T pivot
@@ -479,25 +494,14 @@ def _polish(ch: Floats, t: Floats, q: Floats) -> tuple[Floats, Floats, Floats, f
     s2, c2 = sincos(q[2])
     s3, c3 = sincos(q[3])
     s4, c4 = sincos(q[4])
-    sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
+    sn: Floats = (s0, s1, s2, s3, s4)
+    cs: Floats = (c0, c1, c2, c3, c4)
     x0, x1, x2, x3, x4, first, _ = _newton(ch, t, q, sn, cs)
     big = max(abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
-    q = (q[0] - x0, q[1] - x1, q[2] - x2, q[3] - x3, q[4] - x4)
-    s0, c0 = _turn(s0, c0, x0)
-    s1, c1 = _turn(s1, c1, x1)
-    s2, c2 = _turn(s2, c2, x2)
-    s3, c3 = _turn(s3, c3, x3)
-    s4, c4 = _turn(s4, c4, x4)
-    sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
+    q, sn, cs = _stepped(q, sn, cs, (x0, x1, x2, x3, x4))
     x0, x1, x2, x3, x4, second, size = _newton(ch, t, q, sn, cs)
     big = max(big, abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
-    q = (q[0] - x0, q[1] - x1, q[2] - x2, q[3] - x3, q[4] - x4)
-    s0, c0 = _turn(s0, c0, x0)
-    s1, c1 = _turn(s1, c1, x1)
-    s2, c2 = _turn(s2, c2, x2)
-    s3, c3 = _turn(s3, c3, x3)
-    s4, c4 = _turn(s4, c4, x4)
-    sn, cs = (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4)
+    q, sn, cs = _stepped(q, sn, cs, (x0, x1, x2, x3, x4))
     return q, sn, cs, min(first, second), size, big
 
 
