@@ -291,21 +291,30 @@ def _chain(
 
 @numba.njit(cache=True)
 def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
-    """The exact queries that certify a path: rows (segment, s, pair, motion), chains in order.
+    """The exact queries that certify a path: rows (segment, s, pair, motion, source), chains in
+    order.
 
     path: (M, nq), in [rad]. rows: output columns (segment int64, s float, pair int64, motion
     float [m]: the bound of the pair's motion until the next row of the chain, -1 on a chain's
-    last row), each of shape (capacity,). Returns the number of rows, or -1 when the capacity
-    is too small. A pair whose relative pose does not change on a segment gets one row at
-    s = 0 (unless its sphere gap is positive there).
+    last row; source int64: -1 for a row to query, else the index of an earlier row at the same
+    configuration of the pair, whose distance it is), each of shape (capacity,). Returns the
+    number of rows, or -1 when the capacity is too small.
+
+    A pair whose relative pose does not change on a segment gets one row at s = 0 (unless its
+    sphere gap is positive there), and none when its distance there is already a row's (it was
+    static on the previous segment too, or a chain ended at the shared waypoint). A chain that
+    starts where the pair's previous segment left a row (the shared waypoint) copies that row's
+    distance (about one query per pair near an obstacle and inner waypoint).
     """
-    segment, parameter, pair, motion = rows
+    segment, parameter, pair, motion, source = rows
     count_pairs = model[8].shape[0]
     rates = segment_rates(path, model)
     start, end = np.empty((2, count_pairs)), np.empty((2, count_pairs))
     todo = np.empty(count_pairs, dtype=np.bool_)
     gaps = np.empty((SPHERE_GRID + 1, count_pairs))
     arms = np.empty(((SPHERE_GRID + 1) * count_pairs, path.shape[1]))
+    # per pair: the row holding its distance at the current waypoint (segment k's s = 0), or -1
+    at_waypoint = np.full(count_pairs, -1, dtype=np.int64)
     count = np.int64(0)  # not a literal 0: numba would compile _chain for it as well
     for k in range(path.shape[0] - 1):
         for j in range(path.shape[1]):
@@ -320,21 +329,29 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
             first = count
             if rate == 0.0:
                 if start[0, p] > 0.0:
+                    at_waypoint[p] = -1
                     continue
+                if at_waypoint[p] >= 0:
+                    continue  # the same distance as that row's, on the whole segment
                 if count >= pair.shape[0]:
                     return -1
-                parameter[count], pair[count], motion[count] = 0.0, p, -1.0
+                parameter[count], pair[count], motion[count], source[count] = 0.0, p, -1.0, -1
+                at_waypoint[p] = count
                 count += 1
             elif not todo[p] or (
                 min(start[1, p], end[1, p]) > SPHERE_CHAIN_ABOVE
                 and _sphere_chain(path[k], path[k + 1], p, start[0, p], model, scratch)
             ):
+                at_waypoint[p] = -1
                 continue  # the sphere gaps prove it apart: no exact query
             else:
                 ends = (start[1, p], end[1, p])
                 count = _chain(path[k], path[k + 1], p, ends, model, scratch, rows, count)
                 if count < 0:
                     return -1
+                source[first:count] = -1
+                source[first] = at_waypoint[p]
+                at_waypoint[p] = count - 1  # the chain ends at s = 1: the next waypoint
             segment[first:count] = k
     return int(count)
 

@@ -190,18 +190,22 @@ class ExactVerifier:
             distances[n], pairs[n] = best, best_pair
         return distances, pairs
 
-    def schedule(self, path: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """The rows (segment, s, pair, motion to the next row) to query exactly
-        (:func:`certify.schedule`)."""
+    def schedule(
+        self, path: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The rows (segment, s, pair, motion to the next row, source row) to query exactly
+        (:func:`certify.schedule`; a row with a source >= 0 takes that row's distance)."""
         capacity = _ROWS
         while True:
             segment = np.empty(capacity, dtype=np.int64)
             parameter = np.empty(capacity)
             pair = np.empty(capacity, dtype=np.int64)
             motion = np.empty(capacity)
-            rows = schedule(path, self.model, self.scratch, (segment, parameter, pair, motion))
+            source = np.empty(capacity, dtype=np.int64)
+            columns = (segment, parameter, pair, motion, source)
+            rows = schedule(path, self.model, self.scratch, columns)
             if rows >= 0:
-                return segment[:rows], parameter[:rows], pair[:rows], motion[:rows]
+                return segment[:rows], parameter[:rows], pair[:rows], motion[:rows], source[:rows]
             capacity *= 4
 
     def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
@@ -229,12 +233,20 @@ class ExactVerifier:
 
 
 class _PathCheck:
-    """One path's certification: exact distances by path parameter, bisection, the minimum."""
+    """One path's certification: exact distances by path parameter, bisection, the minimum.
+
+    The scheduled rows' distances stay in arrays (where: path parameter, pair, distance); the
+    few distances queried after them (waypoint minimum, bisection) go to a dict keyed by
+    (path parameter, pair), which also looks the rows up once one of those is needed."""
 
     def __init__(self, verifier: ExactVerifier, path: np.ndarray) -> None:
         self.verifier, self.path = verifier, path
         self._rates: np.ndarray | None = None  # (M - 1, P), for bisection only
-        self.known: dict[tuple[float, int], float] = {}
+        self.where = np.empty(0)
+        self.pair = np.empty(0, dtype=np.int64)
+        self.distance = np.empty(0)
+        self._known: dict[tuple[float, int], float] | None = None
+        self.extra: dict[tuple[float, int], float] = {}
         self.contact: str | None = None
         self.certified = True
         self.refined = 0
@@ -247,12 +259,18 @@ class _PathCheck:
         return self._rates
 
     def distance_at(self, poses: np.ndarray, where: float, pair: int) -> float:
+        """The exact distance of pair at path parameter where (primitive poses (G, 4, 4) there),
+        queried once."""
+        if self._known is None:
+            keys = zip(self.where.tolist(), self.pair.tolist(), strict=True)
+            self._known = dict(zip(keys, self.distance.tolist(), strict=True))
         key = (where, pair)
-        if key not in self.known:
-            self.known[key] = self.verifier.exact(poses, pair)
-            if self.known[key] <= 0.0:
-                self._report_contact(where, pair, self.known[key])
-        return self.known[key]
+        known = self._known.get(key)
+        if known is None:
+            known = self._known[key] = self.extra[key] = self.verifier.exact(poses, pair)
+            if known <= 0.0:
+                self._report_contact(where, pair, known)
+        return known
 
     def _report_contact(self, where: float, pair: int, distance: float) -> None:
         """Record the first contact found (distance <= 0, in [m]) at path parameter where."""
@@ -265,7 +283,7 @@ class _PathCheck:
 
     def run(self) -> None:
         verifier, path = self.verifier, self.path
-        segment, parameter, pair, motion = verifier.schedule(path)
+        segment, parameter, pair, motion, source = verifier.schedule(path)
         rotation, translation = np.empty((len(segment), 2, 3, 3)), np.empty((len(segment), 2, 3))
         bounds = np.empty((len(path), len(verifier.pairs)))
         poses = np.empty((len(path), len(verifier.world.links), 4, 4))
@@ -279,22 +297,26 @@ class _PathCheck:
             (rotation, translation),
             (bounds, poses),
         )
-        distance = verifier.exact_posed(pair, rotation, translation)
-        where = (segment + parameter).tolist()
-        pairs = pair.tolist()
-        self.known = dict(zip(zip(where, pairs, strict=True), distance.tolist(), strict=True))
-        touching = np.flatnonzero(distance <= 0.0)
-        if touching.size:
-            r = int(touching[0])
-            self._report_contact(where[r], pairs[r], float(distance[r]))
+        copies = np.flatnonzero(source >= 0)
+        if copies.size:  # rows at a configuration an earlier row has: its distance
+            query = np.flatnonzero(source < 0)
+            distance = np.empty(len(segment))
+            distance[query] = verifier.exact_posed(pair[query], rotation[query], translation[query])
+            distance[copies] = distance[source[copies]]
+        else:
+            distance = verifier.exact_posed(pair, rotation, translation)
+        self.where, self.pair, self.distance = segment + parameter, pair, distance
+        if distance.size and distance.min() <= 0.0:
+            r = int(np.argmax(distance <= 0.0))
+            self._report_contact(float(self.where[r]), int(pair[r]), float(distance[r]))
             return
         self._waypoint_minimum(bounds, poses)
-        if self.contact is not None or len(pairs) < 2:
+        if self.contact is not None or len(pair) < 2:
             return
-        # Consecutive rows of one chain (same segment and pair, a motion bound between them).
-        same = (segment[1:] == segment[:-1]) & (pair[1:] == pair[:-1]) & (motion[:-1] >= 0.0)
-        for r in np.flatnonzero(same & (distance[:-1] + distance[1:] <= motion[:-1])).tolist():
-            self.bisect(int(segment[r]), pairs[r], float(parameter[r]), float(parameter[r + 1]))
+        # Consecutive rows of one chain: every row but a chain's last has a motion bound >= 0.
+        fails = (motion[:-1] >= 0.0) & (distance[:-1] + distance[1:] <= motion[:-1])
+        for r in np.flatnonzero(fails).tolist():
+            self.bisect(int(segment[r]), int(pair[r]), float(parameter[r]), float(parameter[r + 1]))
             if self.contact is not None or not self.certified:
                 return
 
@@ -302,7 +324,8 @@ class _PathCheck:
         """Certify pair on [s0, s1] of segment k by bisection with exact distances."""
         self.refined += 1
         rate = float(self.rates[k, pair])
-        stack = [(s0, s1, self.known[(k + s0, pair)], self.known[(k + s1, pair)], 0)]
+        start = self.distance_at(np.empty(0), k + s0, pair)  # rows: known, not queried
+        stack = [(s0, s1, start, self.distance_at(np.empty(0), k + s1, pair), 0)]
         while stack:
             a, b, da, db, depth = stack.pop()
             if da + db > rate * (b - a):
@@ -322,10 +345,10 @@ class _PathCheck:
         bounds (N, P), in [m] (every pair whose bound is below the best exact distance is
         queried, at the primitive poses (N, G, 4, 4) of its waypoint)."""
         pairs = bounds.shape[1]
-        if not pairs:
+        best = float(self.distance.min()) if self.distance.size else np.inf
+        if not pairs or bounds.min() >= best:
             return
         flat_bounds = bounds.ravel().tolist()
-        best = min(self.known.values(), default=np.inf)
         for flat in np.argsort(bounds, axis=None).tolist():
             if flat_bounds[flat] >= best:
                 break
@@ -333,11 +356,13 @@ class _PathCheck:
             best = min(best, self.distance_at(poses[n], float(n), pair))
 
     def minimum(self) -> ClearanceRecord:
-        if not self.known:
+        candidates = [(value, key) for key, value in self.extra.items()]
+        if self.distance.size:
+            r = int(np.argmin(self.distance))
+            candidates.append((float(self.distance[r]), (float(self.where[r]), int(self.pair[r]))))
+        if not candidates:
             return ClearanceRecord(float("inf"), "", "", "", float("nan"), -1)
-        known = self.known
-        where, pair = min(known, key=known.__getitem__)
-        clearance = known[(where, pair)]
+        clearance, (where, pair) = min(candidates)
         link, geometry, other = self.verifier.world.pair_names(pair)
         sample = int(where) if where == int(where) else -1
         return ClearanceRecord(clearance, link, geometry, other, where, sample)
