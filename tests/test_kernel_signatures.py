@@ -56,7 +56,7 @@ robot.ik(position=poses[0, :3, 3], approach=poses[0, :3, 2])
 kernels = {
     "rrt_connect_kernel": rrt_connect.rrt_connect_kernel,
     "shortcut_kernel": shortcut.shortcut_kernel,
-    "schedule": certify.schedule,
+    "verification_rows": certify.verification_rows,
     "ik_kernel": ik_kernel.ik_kernel,
     "ik_single_kernel": ik_select.ik_single_kernel,
     "family_ik_kernel": family_kernel.family_ik_kernel,

@@ -290,7 +290,34 @@ def _chain(
 
 
 @numba.njit(cache=True)
-def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
+def _segment_ends(
+    path: np.ndarray,
+    k: int,
+    model: Any,
+    scratch: Any,
+    start: np.ndarray,
+    end: np.ndarray,
+    waypoints: Any,
+) -> None:
+    """Sphere gaps and tight bounds of every pair at both ends of segment k (start, end: (2, P),
+    see :func:`_end_bounds`; start is the previous segment's end), |path[k+1] - path[k]| ->
+    scratch[14]; the waypoints' bounds and poses (waypoints: (M, P), (M, G, 4, 4)) filled."""
+    bounds, poses = waypoints
+    for j in range(path.shape[1]):
+        scratch[14][j] = abs(path[k + 1, j] - path[k, j])
+    if k == 0:
+        _end_bounds(path[k], path[k + 1], 0.0, model, scratch, start)
+        poses[k] = scratch[3]  # (k, not a literal 0: numba cannot assign an array there)
+        bounds[k] = start[1]
+    else:
+        start[:] = end
+    _end_bounds(path[k], path[k + 1], 1.0, model, scratch, end)
+    poses[k + 1] = scratch[3]
+    bounds[k + 1] = end[1]
+
+
+@numba.njit(cache=True)
+def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any, waypoints: Any) -> int:
     """The exact queries that certify a path: rows (segment, s, pair, motion, source), chains in
     order.
 
@@ -298,7 +325,9 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
     float [m]: the bound of the pair's motion until the next row of the chain, -1 on a chain's
     last row; source int64: -1 for a row to query, else the index of an earlier row at the same
     configuration of the pair, whose distance it is), each of shape (capacity,). Returns the
-    number of rows, or -1 when the capacity is too small.
+    number of rows, or -1 when the capacity is too small. waypoints: outputs (bounds (M, P),
+    in [m], poses (M, G, 4, 4)): every pair's tight bound and the primitive poses at each
+    waypoint (a segment's end is the next one's start: computed once).
 
     A pair whose relative pose does not change on a segment gets one row at s = 0 (unless its
     sphere gap is positive there), and none when its distance there is already a row's (it was
@@ -317,10 +346,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any) -> int:
     at_waypoint = np.full(count_pairs, -1, dtype=np.int64)
     count = np.int64(0)  # not a literal 0: numba would compile _chain for it as well
     for k in range(path.shape[0] - 1):
-        for j in range(path.shape[1]):
-            scratch[14][j] = abs(path[k + 1, j] - path[k, j])
-        _end_bounds(path[k], path[k + 1], 0.0, model, scratch, start)
-        _end_bounds(path[k], path[k + 1], 1.0, model, scratch, end)
+        _segment_ends(path, k, model, scratch, start, end, waypoints)
         for p in range(count_pairs):
             todo[p] = rates[k, p] > 0.0 and start[0, p] + end[0, p] <= rates[k, p]
         _sphere_grid(path[k], path[k + 1], todo, model, scratch, gaps, arms)
@@ -418,19 +444,17 @@ def waypoint_bounds(
 
 
 @numba.njit(cache=True)
-def verification_poses(
-    path: np.ndarray,
-    segment: np.ndarray,
-    parameter: np.ndarray,
-    pair: np.ndarray,
-    model: Any,
-    scratch: Any,
-    transforms: Any,
-    waypoints: Any,
-) -> None:
-    """:func:`row_transforms` of the rows (transforms: rotation (R, 2, 3, 3), translation
-    (R, 2, 3), in [m]) and :func:`waypoint_bounds` of path (N, nq) (waypoints: bounds (N, P), in
-    [m], poses (N, G, 4, 4)) in one call: the model and scratch tuples cross into compiled code
-    once (about 5 us a crossing)."""
-    row_transforms(path, segment, parameter, pair, model, scratch, transforms[0], transforms[1])
-    waypoint_bounds(path, model, scratch, waypoints[0], waypoints[1])
+def verification_rows(
+    path: np.ndarray, model: Any, scratch: Any, rows: Any, transforms: Any, waypoints: Any
+) -> int:
+    """:func:`schedule` of path (N, nq) (rows, and waypoints: bounds (N, P), in [m], poses
+    (N, G, 4, 4)) and :func:`row_transforms` of its rows (transforms: rotation (R, 2, 3, 3),
+    translation (R, 2, 3), in [m], R the rows' capacity) in one call: the model and scratch
+    tuples cross into compiled code once (about 4 us a crossing). Returns the number of rows,
+    or -1 when the capacity is too small."""
+    count = schedule(path, model, scratch, rows, waypoints)
+    if count > 0:
+        segment, parameter, pair = rows[0][:count], rows[1][:count], rows[2][:count]
+        rotation, translation = transforms
+        row_transforms(path, segment, parameter, pair, model, scratch, rotation, translation)
+    return count

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import weakref
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -39,9 +40,8 @@ from lynxplan.exceptions import PathVerificationError, StateInCollisionError
 from lynxplan.planning.certify import (
     configuration_poses,
     row_transforms,
-    schedule,
     segment_rates,
-    verification_poses,
+    verification_rows,
     waypoint_bounds,
 )
 from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pairs
@@ -77,6 +77,20 @@ class VerificationReport:
     obstacle_pairs: int
     exact_queries: int
     refined_intervals: int
+
+
+class _Schedule(NamedTuple):
+    """A path's verification rows (R,) and waypoints (N,): see :meth:`ExactVerifier.schedule`."""
+
+    segment: np.ndarray
+    parameter: np.ndarray
+    pair: np.ndarray
+    motion: np.ndarray
+    source: np.ndarray
+    rotation: np.ndarray
+    translation: np.ndarray
+    bounds: np.ndarray
+    poses: np.ndarray
 
 
 class ExactVerifier:
@@ -190,22 +204,31 @@ class ExactVerifier:
             distances[n], pairs[n] = best, best_pair
         return distances, pairs
 
-    def schedule(
-        self, path: np.ndarray
-    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """The rows (segment, s, pair, motion to the next row, source row) to query exactly
-        (:func:`certify.schedule`; a row with a source >= 0 takes that row's distance)."""
+    def schedule(self, path: np.ndarray) -> _Schedule:
+        """The rows to query exactly (:func:`certify.schedule`; a row with a source >= 0 takes
+        that row's distance), their primitives' poses, and the waypoints' bounds and poses
+        (:func:`certify.verification_rows`)."""
         capacity = _ROWS
+        waypoints = (
+            np.empty((len(path), len(self.pairs))),
+            np.empty((len(path), len(self.world.links), 4, 4)),
+        )
         while True:
-            segment = np.empty(capacity, dtype=np.int64)
-            parameter = np.empty(capacity)
-            pair = np.empty(capacity, dtype=np.int64)
-            motion = np.empty(capacity)
-            source = np.empty(capacity, dtype=np.int64)
-            columns = (segment, parameter, pair, motion, source)
-            rows = schedule(path, self.model, self.scratch, columns)
+            columns = (
+                np.empty(capacity, dtype=np.int64),
+                np.empty(capacity),
+                np.empty(capacity, dtype=np.int64),
+                np.empty(capacity),
+                np.empty(capacity, dtype=np.int64),
+            )
+            transforms = (np.empty((capacity, 2, 3, 3)), np.empty((capacity, 2, 3)))
+            rows = verification_rows(path, self.model, self.scratch, columns, transforms, waypoints)
             if rows >= 0:
-                return segment[:rows], parameter[:rows], pair[:rows], motion[:rows], source[:rows]
+                segment, parameter, pair, motion, source = (c[:rows] for c in columns)
+                rotation, translation = transforms[0][:rows], transforms[1][:rows]
+                return _Schedule(
+                    segment, parameter, pair, motion, source, rotation, translation, *waypoints
+                )
             capacity *= 4
 
     def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
@@ -283,20 +306,9 @@ class _PathCheck:
 
     def run(self) -> None:
         verifier, path = self.verifier, self.path
-        segment, parameter, pair, motion, source = verifier.schedule(path)
-        rotation, translation = np.empty((len(segment), 2, 3, 3)), np.empty((len(segment), 2, 3))
-        bounds = np.empty((len(path), len(verifier.pairs)))
-        poses = np.empty((len(path), len(verifier.world.links), 4, 4))
-        verification_poses(
-            path,
-            segment,
-            parameter,
-            pair,
-            verifier.model,
-            verifier.scratch,
-            (rotation, translation),
-            (bounds, poses),
-        )
+        planned = verifier.schedule(path)
+        segment, parameter, pair, motion, source = planned[:5]
+        rotation, translation, bounds, poses = planned[5:]
         copies = np.flatnonzero(source >= 0)
         if copies.size:  # rows at a configuration an earlier row has: its distance
             query = np.flatnonzero(source < 0)
