@@ -446,15 +446,35 @@ def waypoint_bounds(
 @numba.njit(cache=True)
 def verification_rows(
     path: np.ndarray, model: Any, scratch: Any, rows: Any, transforms: Any, waypoints: Any
-) -> int:
-    """:func:`schedule` of path (N, nq) (rows, and waypoints: bounds (N, P), in [m], poses
-    (N, G, 4, 4)) and :func:`row_transforms` of its rows (transforms: rotation (R, 2, 3, 3),
-    translation (R, 2, 3), in [m], R the rows' capacity) in one call: the model and scratch
-    tuples cross into compiled code once (about 4 us a crossing). Returns the number of rows,
-    or -1 when the capacity is too small."""
-    count = schedule(path, model, scratch, rows, waypoints)
-    if count > 0:
-        segment, parameter, pair = rows[0][:count], rows[1][:count], rows[2][:count]
-        rotation, translation = transforms
-        row_transforms(path, segment, parameter, pair, model, scratch, rotation, translation)
-    return count
+) -> tuple[int, int]:
+    """:func:`schedule` of path (N, nq), and the primitives' poses of the rows to query, in one
+    call (the model and scratch tuples cross into compiled code once: about 4 us a crossing).
+
+    rows: columns (segment, s, pair, motion, source, query pair), each (capacity,); the first
+    four as in :func:`schedule`; source becomes each row's index among the queries (a row at a
+    configuration an earlier row has gets that row's), and the queries' pairs are the last
+    column. transforms: the queries' :func:`row_transforms` (rotation (capacity, 2, 3, 3),
+    translation (capacity, 2, 3), in [m]). waypoints: bounds (N, P), in [m], and poses
+    (N, G, 4, 4) at the waypoints. Returns (rows, queries), or (-1, 0) when the capacity is too
+    small.
+    """
+    count = schedule(path, model, scratch, rows[:5], waypoints)
+    if count < 0:
+        return count, 0
+    segment, parameter, pair, lookup, query_pair = rows[0], rows[1], rows[2], rows[4], rows[5]
+    queried = np.empty(count, dtype=np.int64)
+    queries = 0
+    for r in range(count):
+        if lookup[r] < 0:
+            queried[queries] = r
+            query_pair[queries] = pair[r]
+            lookup[r] = queries
+            queries += 1
+        else:
+            lookup[r] = lookup[lookup[r]]
+    which = queried[:queries]
+    rotation, translation = transforms
+    row_transforms(
+        path, segment[which], parameter[which], pair[which], model, scratch, rotation, translation
+    )
+    return count, queries

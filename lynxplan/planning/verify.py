@@ -48,7 +48,7 @@ from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pai
 
 #: Bisection levels of one interval before it is reported as not certified (grazing contact).
 MAX_BISECTION_DEPTH = 40
-#: First capacity of the schedule's rows (doubled while too small).
+#: First capacity of the schedule's rows (grown while too small).
 _ROWS = 1024
 
 
@@ -80,17 +80,30 @@ class VerificationReport:
 
 
 class _Schedule(NamedTuple):
-    """A path's verification rows (R,) and waypoints (N,): see :meth:`ExactVerifier.schedule`."""
+    """A path's verification rows (R,), queries (Q,) and waypoints (N,): see
+    :meth:`ExactVerifier.schedule`."""
 
     segment: np.ndarray
     parameter: np.ndarray
     pair: np.ndarray
     motion: np.ndarray
-    source: np.ndarray
+    #: (R,) each row's index among the queries
+    lookup: np.ndarray
+    #: (Q,) the queries' pairs
+    query_pair: np.ndarray
+    #: (Q, 2, 3, 3), (Q, 2, 3) the queries' primitive poses, in [m]
     rotation: np.ndarray
     translation: np.ndarray
     bounds: np.ndarray
     poses: np.ndarray
+
+
+def _row_buffers(capacity: int) -> tuple[tuple[np.ndarray, ...], tuple[np.ndarray, np.ndarray]]:
+    """Columns and transforms of :func:`certify.verification_rows` for ``capacity`` rows."""
+    columns = tuple(
+        np.empty(capacity, dtype=np.int64 if k in (0, 2, 4, 5) else float) for k in range(6)
+    )
+    return columns, (np.empty((capacity, 2, 3, 3)), np.empty((capacity, 2, 3)))
 
 
 class ExactVerifier:
@@ -124,6 +137,7 @@ class ExactVerifier:
         )
         self._self_pairs = int(world.pair_is_self.sum())
         self.queries = 0
+        self._buffers = _row_buffers(_ROWS)
 
     def exact(self, poses: np.ndarray, pair: int) -> float:
         """coal's signed distance of one pair at primitive poses (G, 4, 4), in [m]."""
@@ -205,31 +219,32 @@ class ExactVerifier:
         return distances, pairs
 
     def schedule(self, path: np.ndarray) -> _Schedule:
-        """The rows to query exactly (:func:`certify.schedule`; a row with a source >= 0 takes
-        that row's distance), their primitives' poses, and the waypoints' bounds and poses
-        (:func:`certify.verification_rows`)."""
-        capacity = _ROWS
+        """The rows to query exactly and their primitives' poses (:func:`certify.schedule`,
+        :func:`certify.verification_rows`), and the waypoints' bounds and poses. The columns are
+        views of buffers kept for the next path."""
         waypoints = (
             np.empty((len(path), len(self.pairs))),
             np.empty((len(path), len(self.world.links), 4, 4)),
         )
         while True:
-            columns = (
-                np.empty(capacity, dtype=np.int64),
-                np.empty(capacity),
-                np.empty(capacity, dtype=np.int64),
-                np.empty(capacity),
-                np.empty(capacity, dtype=np.int64),
+            columns, transforms = self._buffers
+            rows, queries = verification_rows(
+                path, self.model, self.scratch, columns, transforms, waypoints
             )
-            transforms = (np.empty((capacity, 2, 3, 3)), np.empty((capacity, 2, 3)))
-            rows = verification_rows(path, self.model, self.scratch, columns, transforms, waypoints)
             if rows >= 0:
-                segment, parameter, pair, motion, source = (c[:rows] for c in columns)
-                rotation, translation = transforms[0][:rows], transforms[1][:rows]
+                segment, parameter, pair, motion, lookup = (c[:rows] for c in columns[:5])
                 return _Schedule(
-                    segment, parameter, pair, motion, source, rotation, translation, *waypoints
+                    segment,
+                    parameter,
+                    pair,
+                    motion,
+                    lookup,
+                    columns[5][:queries],
+                    transforms[0][:queries],
+                    transforms[1][:queries],
+                    *waypoints,
                 )
-            capacity *= 4
+            self._buffers = _row_buffers(4 * len(columns[0]))
 
     def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
         """Certify a piecewise-linear path (N, nq), in [rad]; see :func:`verify_path`."""
@@ -307,16 +322,10 @@ class _PathCheck:
     def run(self) -> None:
         verifier, path = self.verifier, self.path
         planned = verifier.schedule(path)
-        segment, parameter, pair, motion, source = planned[:5]
-        rotation, translation, bounds, poses = planned[5:]
-        copies = np.flatnonzero(source >= 0)
-        if copies.size:  # rows at a configuration an earlier row has: its distance
-            query = np.flatnonzero(source < 0)
-            distance = np.empty(len(segment))
-            distance[query] = verifier.exact_posed(pair[query], rotation[query], translation[query])
-            distance[copies] = distance[source[copies]]
-        else:
-            distance = verifier.exact_posed(pair, rotation, translation)
+        segment, parameter, pair, motion = planned[:4]
+        exact = verifier.exact_posed(planned.query_pair, planned.rotation, planned.translation)
+        distance = exact[planned.lookup]  # a row at an earlier row's configuration: its distance
+        bounds, poses = planned.bounds, planned.poses
         self.where, self.pair, self.distance = segment + parameter, pair, distance
         if distance.size and distance.min() <= 0.0:
             r = int(np.argmax(distance <= 0.0))
