@@ -240,6 +240,16 @@ def _sphere_grid(
             todo[p] = False
 
 
+@numba.njit(cache=True, inline="always")
+def _grid_clear(gaps: np.ndarray, p: int) -> bool:
+    """Whether pair p's sphere gaps on the grid of :func:`_sphere_grid` (gaps (n + 1, P), in
+    [m]) are all positive. A sphere chain cannot prove a pair apart on a segment where its
+    bounding sphere touches the obstacle at a grid point (the chain's interval over that point
+    would prove the sphere apart there): such a pair goes to the exact chain at once."""
+    smallest: float = gaps[:, p].min()
+    return smallest > 0.0
+
+
 @njit_no_refcount()
 def _chain(
     q_a: np.ndarray,
@@ -366,6 +376,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any, waypoints: A
                 count += 1
             elif not todo[p] or (
                 min(start[1, p], end[1, p]) > SPHERE_CHAIN_ABOVE
+                and _grid_clear(gaps, p)
                 and _sphere_chain(path[k], path[k + 1], p, start[0, p], model, scratch)
             ):
                 at_waypoint[p] = -1

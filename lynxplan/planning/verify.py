@@ -248,7 +248,7 @@ class ExactVerifier:
 
     def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
         """Certify a piecewise-linear path (N, nq), in [rad]; see :func:`verify_path`."""
-        path = np.ascontiguousarray(waypoints, dtype=float)
+        path = kernel_input(np.asarray(waypoints, dtype=float))
         if len(path) == 1:
             path = np.vstack([path, path])
         self.queries = 0
