@@ -45,6 +45,7 @@ from numba import literal_unroll
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from lynxplan import _fastmath
+from lynxplan._fastmath import wide_vectors
 from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
@@ -536,6 +537,7 @@ def _closed_forms(m: int, pr: Floats, shape: Floats, s: np.ndarray) -> None:
     """Both flips and elbows of the block's m poses in the scratch rows s (flat: row k is
     s[k * BLOCK:], at distances LLVM sees, so it needs no aliasing checks): one loop, no branch
     and no call (see the module docstring)."""
+    wide_vectors()
     for i in range(m):
         t = _column_of(s, BLOCK, 0, i)
         for flip in literal_unroll((0, 1)):
@@ -624,6 +626,7 @@ def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     """The m candidates in the rows c (flat: row k is c[k * _CW:]) as they are (an exact model
     of the family: no polish), wrapped into the limits, and the verdict (``_verdict``) at the
     final angles: taken, fallback (see the module docstring), or neither (not a branch)."""
+    wide_vectors()
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
         q0, q1, q2, q3, q4, inside = _wrapped(pr, _angles_of(c, i))
@@ -646,6 +649,7 @@ def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     follow from the polish's by what the limits snapped (``_turn``): only where every step
     and snap is within TAYLOR_STEP is a candidate taken, within FAR_STEP found not to be a
     branch; the others, and an ill-conditioned polish, are left to the second polish."""
+    wide_vectors()
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
         q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i))
@@ -710,6 +714,7 @@ def _first_flips(x: np.ndarray) -> None:
     flip (row _PRIMARY): the target, q and its copy, near a fold, and the flags cleared; x:
     the scratch rows (``_closed_forms``), then the candidate rows (``_polish_settle_all``), one
     flat array (loops of whole vectors: the distances between the rows are constants)."""
+    wide_vectors()
     c = _ROWS * BLOCK
     for k in range(12):
         for i in range(BLOCK):
@@ -783,6 +788,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     targets: (N, 4, 4) rigid poses; reference (N, 5) or (1, 5) [rad]; outputs (N, B, ...), every
     slot written; solved (N,): an exact branch was found.
     """
+    wide_vectors()
     nb = q_out.shape[1]
     per_side = nb // 2
     ch = _chain_tuple(placements, axes)
