@@ -60,6 +60,7 @@ from lynxplan.robots.ik.pose_kernel import (
     VALID,
     WITHIN,
     polish_pose,
+    smallest_error,
     solve_target,
     yaw_match,
 )
@@ -856,13 +857,15 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     position_error: np.ndarray,
     orientation_error: np.ndarray,
     solved: np.ndarray,
+    distance: np.ndarray,
 ) -> int:
     """``pose_kernel`` (same arguments and outputs), by blocks of BLOCK vectorised poses with
     the scalar ``solve_target`` for the poses that need it and the scalar polish for the
     candidates that need it. Returns how many poses needed either.
 
     targets: (N, 4, 4) rigid poses; reference (N, 5) or (1, 5) [rad]; outputs (N, B, ...), every
-    slot written; solved (N,): an exact branch was found.
+    slot written; solved (N,): an exact branch was found; distance (N,): the smallest position
+    error over the slots [m].
     """
     wide_vectors()
     nb = q_out.shape[1]
@@ -1059,19 +1062,6 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 orientation_error[n, b] = angle
             solved[n] = count > 0
             fallbacks += 1 if scalar else 0
+        for i in range(m):  # the block's errors, just written: in cache
+            distance[start + i] = smallest_error(position_error, start + i)
     return fallbacks
-
-
-@numba.njit(cache=True, nogil=True)
-def smallest_errors(errors: np.ndarray) -> np.ndarray:
-    """The smallest error of each target over its branch slots: errors (N, B) -> (N,), the
-    empty slots' NaN skipped (NaN where every slot is empty); ``np.fmin.reduce(errors, axis=1)``
-    without numpy's per-row cost."""
-    out = np.empty(errors.shape[0])
-    for n in range(errors.shape[0]):
-        best = np.nan
-        for b in range(errors.shape[1]):
-            e = errors[n, b]
-            best = e if (e < best) | math.isnan(best) else best
-        out[n] = best
-    return out
