@@ -107,8 +107,11 @@ def _wide_vectors(typingctx: object) -> tuple[object, object]:
 
     def codegen(context: Any, builder: Any, signature: object, args: object) -> Any:
         # llvmlite's attribute set knows only the keyword attributes: the string attribute is
-        # added to the set itself, which llvmlite writes out as given
-        set.add(builder.function.attributes, _WIDE)
+        # added to the set itself, which llvmlite writes out as given. Should a later llvmlite
+        # store its attributes otherwise, the kernel compiles as before (LLVM's own width).
+        attributes = builder.function.attributes
+        if isinstance(attributes, set):
+            set.add(attributes, _WIDE)
         return context.get_dummy_value()
 
     return numba.types.none(), codegen
