@@ -8,7 +8,7 @@ import numba
 import numpy as np
 import pytest
 
-from lynxplan._fastmath import atan2, sincos
+from lynxplan._fastmath import atan2, sincos, wide_vectors
 
 ULP_TOLERANCE = 4.5e-16  # a few units in the last place for values of order 1
 
@@ -68,3 +68,23 @@ def test_atan2_special_values(y: float, x: float) -> None:
     _atan2_many(np.array([y]), np.array([x]), out)
     assert out[0] == pytest.approx(math.atan2(y, x), abs=1e-15)
     assert math.copysign(1.0, out[0]) == math.copysign(1.0, math.atan2(y, x))
+
+
+def test_wide_vectors_reaches_the_compiled_function() -> None:
+    """The 512-bit vector attribute is on the kernel that asks for it, and only there."""
+
+    @numba.njit
+    def wide(x: np.ndarray) -> float:
+        wide_vectors()
+        return float(x.sum())
+
+    @numba.njit
+    def plain(x: np.ndarray) -> float:
+        return float(x.sum())
+
+    x = np.arange(8.0)
+    assert wide(x) == plain(x) == 28.0
+    (wide_ir,) = wide.inspect_llvm().values()
+    (plain_ir,) = plain.inspect_llvm().values()
+    assert '"prefer-vector-width"="512"' in wide_ir
+    assert '"prefer-vector-width"="512"' not in plain_ir

@@ -13,7 +13,7 @@ from lynxplan._arrays import kernel_input
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
-from lynxplan.robots.ik.pose_block import BLOCK, pose_block_kernel, smallest_errors
+from lynxplan.robots.ik.pose_block import BLOCK, pose_block_kernel
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
@@ -74,8 +74,8 @@ def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIk
         # the rest (out of reach, degenerate) goes through the general kernel (root search),
         # its roots packed into the pose layout
         # the rows by index: a boolean mask would be scanned whole by each of the ~10 uses
-        rest = np.flatnonzero(~_pose_fill(robot, target, reference, out))
-        distance = smallest_errors(out.position_error)
+        distance = np.empty(n)
+        rest = np.flatnonzero(~_pose_fill(robot, target, reference, out, distance))
         reachable = np.ones(n, dtype=np.bool_)
         if rest.size:
             sub, ref = _rows(target, reference, rest)
@@ -295,10 +295,13 @@ def solve_pose_one(
     )
 
 
-def _pose_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> np.ndarray:
+def _pose_fill(
+    robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots, distance: np.ndarray
+) -> np.ndarray:
     """Full poses the orientation solves in closed form (``pose_kernel``; from a block of poses
     on, its vectorised form ``pose_block``); returns which. The others (out of reach,
-    degenerate, a given roll) need the general kernel (root search)."""
+    degenerate, a given roll) need the general kernel (root search). distance (N,): output,
+    each target's smallest position error over its slots [m]."""
     family = robot.family
     assert family is not None
     solved = np.empty(target.poses.shape[0], dtype=np.bool_)
@@ -311,6 +314,7 @@ def _pose_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchS
         kernel_input(reference),
         *out,
         solved,
+        distance,
     )
     solved &= np.isnan(target.roll)
     return solved

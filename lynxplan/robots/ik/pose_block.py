@@ -41,10 +41,10 @@ import math
 
 import numba
 import numpy as np
-from numba import literal_unroll
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from lynxplan import _fastmath
+from lynxplan._fastmath import wide_vectors
 from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
@@ -60,6 +60,7 @@ from lynxplan.robots.ik.pose_kernel import (
     VALID,
     WITHIN,
     polish_pose,
+    smallest_error,
     solve_target,
     yaw_match,
 )
@@ -67,9 +68,12 @@ from lynxplan.robots.ik.pose_kernel import (
 _FAST = {"contract", "arcp"}  # fused multiply-adds, reciprocals: as in ``arm.ik_kernel``
 #: Floats in registers: a pose (12, row-major 3 x 4), a Jacobian column (6), the parameters.
 Floats = tuple[float, ...]
-#: One flip's branches: q1, (q2, q3, q4) elbow up, (q2, q3, q4) elbow down, q5, candidate,
+#: One flip (``_flip``): its geometry (12, where ``_branches`` finds the angles), candidate,
 #: fallback, side, near a fold.
-FlipBranches = tuple[float, Floats, Floats, float, bool, bool, float, bool]
+FlipBranches = tuple[Floats, bool, bool, float, bool]
+#: One flip's branches (``_branches``): q of elbow up, q of elbow down, the sines and cosines of
+#: elbow up's q, those of elbow down's (5 each).
+Branches = tuple[Floats, Floats, Floats, Floats, Floats, Floats]
 # The branch-free sine/cosine and arctangent, inlined by LLVM rather than by numba: numba's own
 # inlining (``inline="always"``) of their ~40 call sites would multiply the compile time by 5.
 sincos = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.sincos.py_func)
@@ -94,20 +98,20 @@ ILL_CONDITIONED = 1e-8
 _N_CHAIN = 6 * 12  # the 3 x 4 blocks of M'_1..M'_5, M'_tool (see ``_chain_tuple``)
 _N_PRM = F.N_PARAMS
 
-# Pose scratch rows: the target (row-major 3 x 4), then per flip: q1, (q2, q3, q4) of elbow up
-# and of elbow down, q5, candidate, fallback, side, near a fold (1/0); the pose's fallback.
+# Pose scratch rows: the target (row-major 3 x 4), then per flip: its geometry (12: ``_flip``),
+# candidate, fallback, side, near a fold (1/0); the pose's fallback.
 _FLIP0 = 12
-_F_Q1, _F_UP, _F_DOWN, _F_Q5, _F_CAND, _F_FALL, _F_SIDE, _F_FOLD = 0, 1, 4, 7, 8, 9, 10, 11
-_PER_FLIP = 12
+_F_CAND, _F_FALL, _F_SIDE, _F_FOLD = 12, 13, 14, 15
+_PER_FLIP = 16
 _POSE_FALL = _FLIP0 + 2 * _PER_FLIP
-_PRIMARY = _POSE_FALL + 1  # the first flip that is a candidate (0/1)
-_ROWS = _PRIMARY + 1
+_ROWS = _POSE_FALL + 1
 # Candidate scratch rows (up to 4 per pose): the target (12), q (5), near a fold, the error
 # before the last step, then taken, fallback, within (1/0), position, orientation error,
-# and the closed-form q (5).
+# the closed-form q (5), and the sines and cosines of q (5 each) where the polish starts.
 _C_Q, _C_FOLD, _C_PREV, _C_TAKE, _C_FALL, _C_IN, _C_PERR, _C_OERR = 12, 17, 18, 19, 20, 21, 22, 23
 _C_START = 24  # the closed-form q (5), where a candidate that falls back starts
-_C_ROWS = 29
+_C_SIN, _C_COS = 29, 34
+_C_ROWS = 39
 _CW = 4 * BLOCK  # the candidate rows' width
 #: The candidate loops run on a multiple of this many lanes (AVX-512: 8 doubles).
 LANES = 8
@@ -181,14 +185,16 @@ def _yaw(
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # noqa: PLR0915
-    """The closed-form branches of one flip of the yaw (both elbows) of the target t (12:
-    row-major 3 x 4) on the ideal model: (q1, (q2, q3, q4) of elbow up, the same of elbow down,
-    q5, candidate, fallback, side, near a fold of the elbow); shape: (la, lb, b2, b3) of the
-    two links (``family_geometry.two_link``), then sin, cos and the angle gamma0.
+    """One flip of the yaw (both elbows) of the target t (12: row-major 3 x 4) on the ideal
+    model: (its geometry, where ``_branches`` finds the angles, candidate, fallback, side, near
+    a fold of the elbow); shape: (la, lb, b2, b3) of the two links
+    (``family_geometry.two_link``), sin, cos and the angle gamma0, sin and cos of b2 and of
+    b2 - b3.
 
     The angles enter the geometry through their sines and cosines, which come from the vectors
-    that define them (normalised): arctangents for the angles (two of them shared by both
-    flips), no sine or cosine."""
+    that define them (normalised): arctangents only for the yaw (two of them shared by both
+    flips), no sine or cosine; the other angles' arctangents are left to ``_branches``, for
+    the flip that is taken."""
     rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
           pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
     g0 = t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]
@@ -233,15 +239,14 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     side = 1.0 if ok1 else 0.0
     phi2 = yaw1 if ok1 else yaw0
     s2, c2 = (s_yaw1, c_yaw1) if ok1 else (s_yaw0, c_yaw0)
-    big2, sp, cp, flat2 = _pitch_sum(shape, a_h, a_p, a_k, s2, c2)
+    _, sp, cp, flat2 = _pitch_sum(shape, a_h, a_p, a_k, s2, c2)
     st2, ct2 = _roll_terms(pr, g, s2, c2, sp, cp)  # a tool on the roll axis: of the side's yaw
     on_roll_axis = pr[F.OFF_AXIS] == 0.0
     st, ct = (st2, ct2) if on_roll_axis else (st, ct)
-    theta = atan2(st, ct)
     x, y = c2 * dh - s2 * dp, dk
     wh = pr[F.W0] + ct * pr[F.E1] + st * pr[F.E2]
     wk = pr[F.W0 + 1] + ct * pr[F.E1 + 1] + st * pr[F.E2 + 1]
-    la, lb, b2, b3 = shape[0], shape[1], shape[2], shape[3]
+    la, lb = shape[0], shape[1]
     rx = x - (cp * wh - sp * wk) - pr[F.O2]
     ry = y - (sp * wh + cp * wk) - pr[F.O2 + 1]
     dist = math.sqrt(rx * rx + ry * ry)
@@ -252,32 +257,77 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     # where the scalar solver starts the two elbows apart (a near-family model): its result
     fold_start = (pr[F.EXACT] == 0.0) & (abs(cosd) > 1.0 - 1e-6)
     fold = abs(cosd) > 1.0 - FOLD_BAND
-    sd, cd = math.sqrt((1.0 - cosd) * (1.0 + cosd)), cosd  # delta = arccos(cosd) in [0, pi]
-    delta = atan2(sd, cd)
-    toward = atan2(ry, rx)
-    bend = atan2(lb * sd, la + lb * cd)
     miss = math.sqrt(reach * reach + lat_miss * lat_miss)
     candidate = (ok0 | ok1) & (miss <= REACH_MISS)
     finite = math.isfinite(d0 + d1 + d2 + a0 + a1 + a2 + g0 + g4 + g8)
     fallback = axial | flat1 | flat2 | on_axis | (ok0 & ok1) | (candidate & fold_start)
     fallback |= not finite
+    x_pitch = c2 * a_h - s2 * a_p  # the pitch sum is atan2(a_k, x_pitch) - gamma0
+    geometry = (phi2, s2, c2, a_k, x_pitch, sp, cp, st, ct, rx, ry, cosd)
+    return geometry, candidate, fallback, side, fold
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _branches(pr: Floats, shape: Floats, geometry: Floats) -> Branches:
+    """The angles q (5) of elbow up and of elbow down of one flip, and their sines and
+    cosines (5 each), from its geometry (``_flip``): the yaw, its sine and cosine, the
+    approach's components along k and in the arm plane, the pitch sum's sine and cosine, the
+    roll's, the shoulder-to-wrist vector and the elbow's cosine."""
+    phi2, s2, c2, a_k, x_pitch, sp, cp, st, ct, rx, ry, cd = geometry
+    la, lb, b2, b3 = shape[0], shape[1], shape[2], shape[3]
+    big2 = atan2(a_k, x_pitch) - shape[6]
+    theta = atan2(st, ct)
+    sd = math.sqrt((1.0 - cd) * (1.0 + cd))  # delta = arccos(cd) in [0, pi]
+    delta = atan2(sd, cd)
+    toward = atan2(ry, rx)
+    bend = atan2(lb * sd, la + lb * cd)
     # elbow up (0): the elbow above the shoulder-wrist line, the elbow angle -delta
     up2, down2 = toward + bend - b2, toward - bend - b2
     up3, down3 = b2 - b3 - delta, b2 - b3 + delta
+    sigma = (pr[F.SIGMA], pr[F.SIGMA + 1], pr[F.SIGMA + 2], pr[F.SIGMA + 3], pr[F.SIGMA + 4])
+    q1, q5 = sigma[0] * phi2, sigma[4] * theta
+    up = (q1, sigma[1] * up2, sigma[2] * up3, sigma[3] * (big2 - up2 - up3), q5)
+    down = (q1, sigma[1] * down2, sigma[2] * down3, sigma[3] * (big2 - down2 - down3), q5)
+    # the sines and cosines of the angles, from those of toward, bend, delta and the constants
+    s_to, c_to = _unit(ry, rx)
+    s_be, c_be = _unit(lb * sd, la + lb * cd)
+    sines_up, cosines_up = _elbow_terms(shape, sigma, s_to, c_to, s_be, c_be, -sd, cd, sp, cp)
+    sines_down, cosines_down = _elbow_terms(shape, sigma, s_to, c_to, -s_be, c_be, sd, cd, sp, cp)
+    s1, s5 = sigma[0] * s2, sigma[4] * st
     return (
-        pr[F.SIGMA] * phi2,
-        (pr[F.SIGMA + 1] * up2, pr[F.SIGMA + 2] * up3, pr[F.SIGMA + 3] * (big2 - up2 - up3)),
-        (
-            pr[F.SIGMA + 1] * down2,
-            pr[F.SIGMA + 2] * down3,
-            pr[F.SIGMA + 3] * (big2 - down2 - down3),
-        ),
-        pr[F.SIGMA + 4] * theta,
-        candidate,
-        fallback,
-        side,
-        fold,
+        up,
+        down,
+        (s1, sines_up[0], sines_up[1], sines_up[2], s5),
+        (c2, cosines_up[0], cosines_up[1], cosines_up[2], ct),
+        (s1, sines_down[0], sines_down[1], sines_down[2], s5),
+        (c2, cosines_down[0], cosines_down[1], cosines_down[2], ct),
     )
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _elbow_terms(
+    shape: Floats,
+    sigma: Floats,
+    s_to: float,
+    c_to: float,
+    s_be: float,
+    c_be: float,
+    s_de: float,
+    c_de: float,
+    s_big: float,
+    c_big: float,
+) -> tuple[Floats, Floats]:
+    """The sines and cosines of q2, q3, q4 of one elbow (``_flip``): q2 = toward + bend - b2,
+    q3 = b2 - b3 + delta' and q4 = big - q2 - q3, each times its sign sigma (5, all joints),
+    from the sines and cosines of toward, bend (its sign the elbow's), delta' (-delta for the
+    elbow up) and the pitch sum big; shape[7:11]: those of b2 and b2 - b3."""
+    s_b2, c_b2, s_23, c_23 = shape[7], shape[8], shape[9], shape[10]
+    s_a, c_a = s_to * c_be + c_to * s_be, c_to * c_be - s_to * s_be  # toward + bend
+    s_q2, c_q2 = s_a * c_b2 - c_a * s_b2, c_a * c_b2 + s_a * s_b2
+    s_q3, c_q3 = s_23 * c_de + c_23 * s_de, c_23 * c_de - s_23 * s_de
+    s_23q, c_23q = s_q2 * c_q3 + c_q2 * s_q3, c_q2 * c_q3 - s_q2 * s_q3  # q2 + q3
+    s_q4, c_q4 = s_big * c_23q - c_big * s_23q, c_big * c_23q + s_big * s_23q
+    return (sigma[1] * s_q2, sigma[2] * s_q3, sigma[3] * s_q4), (c_q2, c_q3, c_q4)
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -481,21 +531,17 @@ def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _polish(ch: Floats, t: Floats, q: Floats) -> tuple[Floats, Floats, Floats, float, float, float]:
-    """Two Gauss-Newton steps on the exact chain from q (5): the final q, its sines and
-    cosines, the smaller of the two conditionings (``_newton``), the largest component of the
-    pose error before the last step, and the largest step [rad] of either.
+def _polish(
+    ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats
+) -> tuple[Floats, Floats, Floats, float, float, float]:
+    """Two Gauss-Newton steps on the exact chain from q (5) of sines sn and cosines cs: the
+    final q, its sines and cosines, the smaller of the two conditionings (``_newton``), the
+    largest component of the pose error before the last step, and the largest step [rad] of
+    either.
 
-    The sines and cosines of the start come from ``sincos``; those after each step from the
-    ones before it (``_turn``): exact to rounding where the steps are within TAYLOR_STEP, and
-    still good enough for the second step's direction where they are not."""
-    s0, c0 = sincos(q[0])
-    s1, c1 = sincos(q[1])
-    s2, c2 = sincos(q[2])
-    s3, c3 = sincos(q[3])
-    s4, c4 = sincos(q[4])
-    sn: Floats = (s0, s1, s2, s3, s4)
-    cs: Floats = (c0, c1, c2, c3, c4)
+    The sines and cosines after each step follow from the ones before it (``_turn``): exact to
+    rounding where the steps are within TAYLOR_STEP, and still good enough for the second
+    step's direction where they are not."""
     x0, x1, x2, x3, x4, first, _ = _newton(ch, t, q, sn, cs)
     big = max(abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
     q, sn, cs = _stepped(q, sn, cs, (x0, x1, x2, x3, x4))
@@ -532,27 +578,78 @@ def _rotation_angle(p: Floats, t: Floats) -> float:
 
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
-def _closed_forms(m: int, pr: Floats, shape: Floats, s: np.ndarray) -> None:
-    """Both flips and elbows of the block's m poses in the scratch rows s (flat: row k is
-    s[k * BLOCK:], at distances LLVM sees, so it needs no aliasing checks): one loop, no branch
-    and no call (see the module docstring)."""
-    for i in range(m):
-        t = _column_of(s, BLOCK, 0, i)
-        for flip in literal_unroll((0, 1)):
-            q1, up, down, q5, cand, fall, side, fold = _flip(pr, shape, t, flip)
-            base = (_FLIP0 + flip * _PER_FLIP) * BLOCK + i
-            s[base + _F_Q1 * BLOCK] = q1
-            s[base + _F_UP * BLOCK] = up[0]
-            s[base + (_F_UP + 1) * BLOCK] = up[1]
-            s[base + (_F_UP + 2) * BLOCK] = up[2]
-            s[base + _F_DOWN * BLOCK] = down[0]
-            s[base + (_F_DOWN + 1) * BLOCK] = down[1]
-            s[base + (_F_DOWN + 2) * BLOCK] = down[2]
-            s[base + _F_Q5 * BLOCK] = q5
-            s[base + _F_CAND * BLOCK] = 1.0 if cand else 0.0
-            s[base + _F_FALL * BLOCK] = 1.0 if fall else 0.0
-            s[base + _F_SIDE * BLOCK] = side
-            s[base + _F_FOLD * BLOCK] = 1.0 if fold else 0.0
+def _closed_forms(pr: Floats, shape: Floats, x: np.ndarray) -> None:
+    """Both flips and elbows of the block's poses in the scratch rows (x[: _ROWS * BLOCK], row
+    k at x[k * BLOCK:]), and pose i's first candidate flip (flip 0 where it is a candidate, else
+    flip 1) in the candidate rows (x[_ROWS * BLOCK:], row k at x[_ROWS * BLOCK + k * _CW:]):
+    lane i its elbow up, lane BLOCK + i its elbow down (the target, q and its copy, the sines and
+    cosines, near a fold, the flags cleared). One loop, no branch and no call (see the module
+    docstring); one array at distances LLVM sees, so it needs no aliasing checks. The loop runs
+    over the whole block (in a last block of fewer poses, the rows past them hold earlier poses
+    or zeros, their results unused): with a constant count LLVM sees that no store reaches a
+    target."""
+    wide_vectors()
+    for i in range(BLOCK):
+        t = _column_of(x, BLOCK, 0, i)
+        first = _flip(pr, shape, t, 0)
+        other = _flip(pr, shape, t, 1)
+        _put_flip(x, i, 0, first)
+        _put_flip(x, i, 1, other)
+        pick = first[1]  # flip 0 where it is a candidate (selects, scalar by scalar)
+        g0, g1 = first[0], other[0]
+        geometry = (
+            g0[0] if pick else g1[0], g0[1] if pick else g1[1], g0[2] if pick else g1[2],
+            g0[3] if pick else g1[3], g0[4] if pick else g1[4], g0[5] if pick else g1[5],
+            g0[6] if pick else g1[6], g0[7] if pick else g1[7], g0[8] if pick else g1[8],
+            g0[9] if pick else g1[9], g0[10] if pick else g1[10], g0[11] if pick else g1[11],
+        )  # fmt: skip
+        fold = first[4] if pick else other[4]
+        up, down, sines_up, cosines_up, sines_down, cosines_down = _branches(pr, shape, geometry)
+        _put_candidate(x, i, t, up, sines_up, cosines_up, fold)
+        _put_candidate(x, BLOCK + i, t, down, sines_down, cosines_down, fold)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _put_flip(x: np.ndarray, i: int, flip: int, branches: FlipBranches) -> None:
+    """One flip of pose i (``_flip``) into the scratch rows x (``_closed_forms``)."""
+    geometry, cand, fall, side, fold = branches
+    base = (_FLIP0 + flip * _PER_FLIP) * BLOCK + i
+    x[base], x[base + BLOCK], x[base + 2 * BLOCK] = geometry[0], geometry[1], geometry[2]
+    x[base + 3 * BLOCK], x[base + 4 * BLOCK] = geometry[3], geometry[4]
+    x[base + 5 * BLOCK], x[base + 6 * BLOCK] = geometry[5], geometry[6]
+    x[base + 7 * BLOCK], x[base + 8 * BLOCK] = geometry[7], geometry[8]
+    x[base + 9 * BLOCK], x[base + 10 * BLOCK] = geometry[9], geometry[10]
+    x[base + 11 * BLOCK] = geometry[11]
+    x[base + _F_CAND * BLOCK] = 1.0 if cand else 0.0
+    x[base + _F_FALL * BLOCK] = 1.0 if fall else 0.0
+    x[base + _F_SIDE * BLOCK] = side
+    x[base + _F_FOLD * BLOCK] = 1.0 if fold else 0.0
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _put_candidate(
+    x: np.ndarray, lane: int, t: Floats, q: Floats, sines: Floats, cosines: Floats, fold: bool
+) -> None:
+    """A candidate of target t (12) at angles q (5) of these sines and cosines into lane
+    ``lane`` of the candidate rows of x (``_closed_forms``), its flags cleared (written out:
+    a loop here would keep the caller's loop from vectorising)."""
+    b = _ROWS * BLOCK + lane
+    x[b], x[b + _CW], x[b + 2 * _CW], x[b + 3 * _CW] = t[0], t[1], t[2], t[3]
+    x[b + 4 * _CW], x[b + 5 * _CW], x[b + 6 * _CW], x[b + 7 * _CW] = t[4], t[5], t[6], t[7]
+    x[b + 8 * _CW], x[b + 9 * _CW], x[b + 10 * _CW], x[b + 11 * _CW] = t[8], t[9], t[10], t[11]
+    _put5(x, b + _C_Q * _CW, q)
+    _put5(x, b + _C_START * _CW, q)
+    _put5(x, b + _C_SIN * _CW, sines)
+    _put5(x, b + _C_COS * _CW, cosines)
+    x[b + _C_FOLD * _CW] = 1.0 if fold else 0.0
+    x[b + _C_FALL * _CW] = 0.0
+    x[b + _C_PREV * _CW] = 0.0
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _put5(x: np.ndarray, b: int, v: Floats) -> None:
+    """v (5) into x[b + k * _CW], k = 0..4 (five candidate rows)."""
+    x[b], x[b + _CW], x[b + 2 * _CW], x[b + 3 * _CW], x[b + 4 * _CW] = v[0], v[1], v[2], v[3], v[4]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -564,6 +661,13 @@ def _column_of(rows: np.ndarray, width: int, first: int, i: int) -> Floats:
         rows[b + 4 * width], rows[b + 5 * width], rows[b + 6 * width], rows[b + 7 * width],
         rows[b + 8 * width], rows[b + 9 * width], rows[b + 10 * width], rows[b + 11 * width],
     )  # fmt: skip
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _column_of5(c: np.ndarray, first: int, i: int) -> Floats:
+    """The 5 values c[(first + k) * _CW + i], k = 0..4, of the candidate rows c."""
+    b = first * _CW + i
+    return c[b], c[b + _CW], c[b + 2 * _CW], c[b + 3 * _CW], c[b + 4 * _CW]
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -624,6 +728,7 @@ def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     """The m candidates in the rows c (flat: row k is c[k * _CW:]) as they are (an exact model
     of the family: no polish), wrapped into the limits, and the verdict (``_verdict``) at the
     final angles: taken, fallback (see the module docstring), or neither (not a branch)."""
+    wide_vectors()
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
         q0, q1, q2, q3, q4, inside = _wrapped(pr, _angles_of(c, i))
@@ -646,9 +751,11 @@ def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     follow from the polish's by what the limits snapped (``_turn``): only where every step
     and snap is within TAYLOR_STEP is a candidate taken, within FAR_STEP found not to be a
     branch; the others, and an ill-conditioned polish, are left to the second polish."""
+    wide_vectors()
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
-        q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i))
+        sines, cosines = _column_of5(c, _C_SIN, i), _column_of5(c, _C_COS, i)
+        q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i), sines, cosines)
         w0, w1, w2, w3, w4, inside = _wrapped(pr, q)
         r0, r1, r2 = _snap(q[0], w0), _snap(q[1], w1), _snap(q[2], w2)
         r3, r4 = _snap(q[3], w3), _snap(q[4], w4)
@@ -694,6 +801,8 @@ def _repolish(
         k = index[min(j, count - 1)]
         for row in range(_C_ROWS):
             c2[row, j] = c[row, k]
+        for row in range(5):  # the sines and cosines where the first polish stopped
+            c2[_C_SIN + row, j], c2[_C_COS + row, j] = sincos(c2[_C_Q + row, j])
     _polish_settle_all(lanes, pr, ch, c2_flat)
     for j in range(count):
         if c2[_C_TAKE, j] == 0.0:
@@ -702,33 +811,6 @@ def _repolish(
         for row in (_C_Q, _C_Q + 1, _C_Q + 2, _C_Q + 3, _C_Q + 4, _C_IN, _C_PERR, _C_OERR):
             c[row, k] = c2[row, j]
         c[_C_TAKE, k], c[_C_FALL, k] = 1.0, 0.0
-
-
-@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
-def _first_flips(x: np.ndarray) -> None:
-    """The candidate lanes i (elbow up) and BLOCK + i (elbow down) of pose i's first candidate
-    flip (row _PRIMARY): the target, q and its copy, near a fold, and the flags cleared; x:
-    the scratch rows (``_closed_forms``), then the candidate rows (``_polish_settle_all``), one
-    flat array (loops of whole vectors: the distances between the rows are constants)."""
-    c = _ROWS * BLOCK
-    for k in range(12):
-        for i in range(BLOCK):
-            x[c + k * _CW + i] = x[k * BLOCK + i]
-            x[c + k * _CW + BLOCK + i] = x[k * BLOCK + i]
-    for i in range(BLOCK):
-        second = x[_PRIMARY * BLOCK + i] != 0.0
-        one, two = _FLIP0 * BLOCK + i, (_FLIP0 + _PER_FLIP) * BLOCK + i
-        for k in range(5):
-            row = (_F_Q1, _F_UP, _F_UP + 1, _F_UP + 2, _F_Q5)[k] * BLOCK
-            up = x[two + row] if second else x[one + row]
-            row = (_F_Q1, _F_DOWN, _F_DOWN + 1, _F_DOWN + 2, _F_Q5)[k] * BLOCK
-            down = x[two + row] if second else x[one + row]
-            x[c + (_C_Q + k) * _CW + i] = x[c + (_C_START + k) * _CW + i] = up
-            x[c + (_C_Q + k) * _CW + BLOCK + i] = x[c + (_C_START + k) * _CW + BLOCK + i] = down
-        fold = x[two + _F_FOLD * BLOCK] if second else x[one + _F_FOLD * BLOCK]
-        x[c + _C_FOLD * _CW + i] = x[c + _C_FOLD * _CW + BLOCK + i] = fold
-        x[c + _C_FALL * _CW + i] = x[c + _C_FALL * _CW + BLOCK + i] = 0.0
-        x[c + _C_PREV * _CW + i] = x[c + _C_PREV * _CW + BLOCK + i] = 0.0
 
 
 @numba.njit(cache=True, nogil=True)
@@ -775,14 +857,17 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     position_error: np.ndarray,
     orientation_error: np.ndarray,
     solved: np.ndarray,
+    distance: np.ndarray,
 ) -> int:
     """``pose_kernel`` (same arguments and outputs), by blocks of BLOCK vectorised poses with
     the scalar ``solve_target`` for the poses that need it and the scalar polish for the
     candidates that need it. Returns how many poses needed either.
 
     targets: (N, 4, 4) rigid poses; reference (N, 5) or (1, 5) [rad]; outputs (N, B, ...), every
-    slot written; solved (N,): an exact branch was found.
+    slot written; solved (N,): an exact branch was found; distance (N,): the smallest position
+    error over the slots [m].
     """
+    wide_vectors()
     nb = q_out.shape[1]
     per_side = nb // 2
     ch = _chain_tuple(placements, axes)
@@ -792,17 +877,22 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
     gamma0 = prm[F.GAMMA0]
+    b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
     shape = (
         math.hypot(l20, l21),
         math.hypot(l30, l31),
-        math.atan2(l21, l20),
-        math.atan2(l31, l30),
+        b2,
+        b3,
         math.sin(gamma0),
         math.cos(gamma0),
         gamma0,
+        math.sin(b2),
+        math.cos(b2),
+        math.sin(b2 - b3),
+        math.cos(b2 - b3),
     )
-    # the scratch rows and the candidate rows in one array (constant distances: ``_first_flips``)
-    x_flat = np.empty(_ROWS * BLOCK + _C_ROWS * _CW)
+    # the scratch rows and the candidate rows in one array (constant distances: ``_closed_forms``)
+    x_flat = np.zeros(_ROWS * BLOCK + _C_ROWS * _CW)
     s_flat, c_flat = x_flat[: _ROWS * BLOCK], x_flat[_ROWS * BLOCK :]
     c2_flat, slot_index = np.empty(_C_ROWS * _CW), np.empty(_CW, dtype=np.int64)
     s, c = s_flat.reshape((_ROWS, BLOCK)), c_flat.reshape((_C_ROWS, _CW))
@@ -821,11 +911,11 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             for r in range(3):
                 for col in range(4):
                     s[4 * r + col, i] = targets[start + i, r, col]
-        _closed_forms(m, pr, shape, s_flat)
+        _closed_forms(pr, shape, x_flat)
         # the candidates of the poses that need no fallback, in the scalar solver's order: lane
-        # i the elbow up and lane BLOCK + i the elbow down of pose i's first candidate flip (copied
-        # from the scratch rows by whole vectors), then the other flip where it is a candidate
-        # too (rare: its yaw misses by twice the lateral offset), gathered one by one
+        # i the elbow up and lane BLOCK + i the elbow down of pose i's first candidate flip
+        # (written by _closed_forms), then the other flip where it is a candidate too (rare:
+        # its yaw misses by twice the lateral offset), gathered one by one
         mc = np.int64(2 * BLOCK)  # not a literal: one compile of _repolish
         second_flips = False
         for i in range(m):  # by selects: the first flip's lanes and slots
@@ -833,7 +923,6 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             cand0 = s[_FLIP0 + _F_CAND, i] != 0.0
             cand1 = s[_FLIP0 + _PER_FLIP + _F_CAND, i] != 0.0
             s[_POSE_FALL, i] = 1.0 if fall else 0.0
-            s[_PRIMARY, i] = 0.0 if cand0 else 1.0
             owned[i] = 2 if (not fall) and (cand0 or cand1) else 0
             second_flips = second_flips or ((not fall) and cand0 and cand1)
             base = _FLIP0 + (0 if cand0 else _PER_FLIP)
@@ -856,16 +945,20 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     if owned[i] >= 2:  # the second flip: gathered
                         for k in range(12):
                             c[k, mc] = s[k, i]
-                        c[_C_Q, mc] = s[base + _F_Q1, i]
-                        for k in range(3):
-                            c[_C_Q + 1 + k, mc] = s[base + (_F_DOWN if elbow else _F_UP) + k, i]
-                        c[_C_Q + 4, mc] = s[base + _F_Q5, i]
+                        geometry = (s[base, i], s[base + 1, i], s[base + 2, i], s[base + 3, i],
+                                    s[base + 4, i], s[base + 5, i], s[base + 6, i], s[base + 7, i],
+                                    s[base + 8, i], s[base + 9, i], s[base + 10, i],
+                                    s[base + 11, i])  # fmt: skip
+                        up, down, s_up, c_up, s_down, c_down = _branches(pr, shape, geometry)
+                        for k in range(5):
+                            c[_C_Q + k, mc] = down[k] if elbow else up[k]
+                            c[_C_SIN + k, mc] = s_down[k] if elbow else s_up[k]
+                            c[_C_COS + k, mc] = c_down[k] if elbow else c_up[k]
                         c[_C_FOLD, mc] = s[base + _F_FOLD, i]
                         mc += 1
                     lane_of[4 * i + owned[i]] = lane
                     slot_of[lane] = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
                     owned[i] += 1
-        _first_flips(x_flat)
         for lane in range(2 * BLOCK, mc):
             for k in range(5):
                 c[_C_START + k, lane] = c[_C_Q + k, lane]
@@ -969,19 +1062,6 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 orientation_error[n, b] = angle
             solved[n] = count > 0
             fallbacks += 1 if scalar else 0
+        for i in range(m):  # the block's errors, just written: in cache
+            distance[start + i] = smallest_error(position_error, start + i)
     return fallbacks
-
-
-@numba.njit(cache=True, nogil=True)
-def smallest_errors(errors: np.ndarray) -> np.ndarray:
-    """The smallest error of each target over its branch slots: errors (N, B) -> (N,), the
-    empty slots' NaN skipped (NaN where every slot is empty); ``np.fmin.reduce(errors, axis=1)``
-    without numpy's per-row cost."""
-    out = np.empty(errors.shape[0])
-    for n in range(errors.shape[0]):
-        best = np.nan
-        for b in range(errors.shape[1]):
-            e = errors[n, b]
-            best = e if (e < best) | math.isnan(best) else best
-        out[n] = best
-    return out

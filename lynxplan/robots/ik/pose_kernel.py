@@ -367,6 +367,17 @@ def pose_one(
     return k
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def smallest_error(errors: np.ndarray, n: int) -> float:
+    """The smallest of errors[n, :] (a target's errors over its branch slots, (N, B)), the
+    empty slots' NaN skipped (NaN where every slot is empty): ``np.fmin.reduce`` of the row."""
+    best = np.nan
+    for b in range(errors.shape[1]):
+        e = errors[n, b]
+        best = e if (e < best) | math.isnan(best) else best
+    return best
+
+
 @numba.njit(cache=True, nogil=True)
 def pose_kernel(
     prm: np.ndarray,
@@ -380,6 +391,7 @@ def pose_kernel(
     position_error: np.ndarray,
     orientation_error: np.ndarray,
     solved: np.ndarray,
+    distance: np.ndarray,
 ) -> None:
     """``solve_target`` of N full poses, in the batch arrays.
 
@@ -390,6 +402,8 @@ def pose_kernel(
         q_out, valid, within, position_error, orientation_error: (N, B, ...) outputs in the
             kernel's layout; every slot of every target is written.
         solved: (N,) output: True where an exact branch was found (the target is complete).
+        distance: (N,) output: each target's smallest position error over its slots [m]
+            (``smallest_error``).
     """
     nb = q_out.shape[1]
     out = np.empty((nb, SLOT_COLUMNS))
@@ -423,3 +437,4 @@ def pose_kernel(
             within[n, b] = out[b, WITHIN] != 0.0
             position_error[n, b] = out[b, POSITION_ERROR]
             orientation_error[n, b] = out[b, ORIENTATION_ERROR]
+        distance[n] = smallest_error(position_error, n)
