@@ -296,16 +296,22 @@ class _PathCheck:
             self._rates = segment_rates(self.path, self.verifier.model)
         return self._rates
 
-    def distance_at(self, poses: np.ndarray, where: float, pair: int) -> float:
-        """The exact distance of pair at path parameter where (primitive poses (G, 4, 4) there),
-        queried once."""
+    @property
+    def known(self) -> dict[tuple[float, int], float]:
+        """Every exact distance so far by (path parameter, pair), in [m] (the rows' built on
+        first use)."""
         if self._known is None:
             keys = zip(self.where.tolist(), self.pair.tolist(), strict=True)
             self._known = dict(zip(keys, self.distance.tolist(), strict=True))
+        return self._known
+
+    def distance_at(self, poses: np.ndarray, where: float, pair: int) -> float:
+        """The exact distance of pair at path parameter where (primitive poses (G, 4, 4) there),
+        queried once."""
         key = (where, pair)
-        known = self._known.get(key)
+        known = self.known.get(key)
         if known is None:
-            known = self._known[key] = self.extra[key] = self.verifier.exact(poses, pair)
+            known = self.known[key] = self.extra[key] = self.verifier.exact(poses, pair)
             if known <= 0.0:
                 self._report_contact(where, pair, known)
         return known
@@ -345,8 +351,7 @@ class _PathCheck:
         """Certify pair on [s0, s1] of segment k by bisection with exact distances."""
         self.refined += 1
         rate = float(self.rates[k, pair])
-        start = self.distance_at(np.empty(0), k + s0, pair)  # rows: known, not queried
-        stack = [(s0, s1, start, self.distance_at(np.empty(0), k + s1, pair), 0)]
+        stack = [(s0, s1, self.known[(k + s0, pair)], self.known[(k + s1, pair)], 0)]
         while stack:
             a, b, da, db, depth = stack.pop()
             if da + db > rate * (b - a):

@@ -151,3 +151,25 @@ def test_exact_rows_are_the_worlds_exact_distances(arm: Arm, world: CollisionWor
     np.testing.assert_allclose(got, expected, atol=COAL_GJK_TOLERANCE)
     # The sample reaches contacts and clear pairs alike.
     assert (every.min(axis=1) < 0).any() and (got > 0).any()
+
+
+def test_every_scheduled_row_has_its_exact_distance(arm: Arm, world: CollisionWorld) -> None:
+    """A row the schedule does not query (a chain starting at a waypoint where the pair's
+    previous segment left a row, a pair static on consecutive segments) gets the distance of
+    the row it points to: every row's distance equals the world's exact distance at its own
+    configuration, and some rows are such copies."""
+    verifier = verifier_of(world)
+    rng = np.random.default_rng(21)
+    copies = 0
+    for _ in range(RANDOM_PATHS):
+        path = np.ascontiguousarray(_random_path(arm, rng))
+        planned = verifier.schedule(path)
+        exact = verifier.exact_posed(planned.query_pair, planned.rotation, planned.translation)
+        got = exact[planned.lookup]
+        q = path[planned.segment] + planned.parameter[:, None] * (
+            path[planned.segment + 1] - path[planned.segment]
+        )
+        expected = world.distances(q)[np.arange(len(q)), planned.pair]
+        np.testing.assert_allclose(got, expected, atol=COAL_GJK_TOLERANCE)
+        copies += len(planned.pair) - len(planned.query_pair)
+    assert copies > 0
