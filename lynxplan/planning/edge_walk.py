@@ -17,9 +17,10 @@ real geometry with distance >= ``clearance``: no sampling resolution, nothing sk
 samples.
 
 Most pairs are certified before any step, from every pair's bounds at the edge's start, its end
-and (when a quick test of it came first) its midpoint, computed all pairs at once
-(:func:`lynxplan.planning.lanes.all_pair_bounds`), with the static motion bound
-(:func:`_walk_start`).
+and the points where quick tests of it came first (a grid: its midpoint, or its quarters),
+computed all pairs at once (:func:`lynxplan.planning.lanes.all_pair_bounds`), with the static
+motion bound (:func:`_walk_start`); a pair that the grid certifies from some point to the end
+stops walking there.
 A pair that needs steps advances through several points per vectorised call
 (:func:`lynxplan.planning.lanes.pair_along`, :func:`_lane_run`); each accepted point passes the
 same one- or two-sided test as a single step.
@@ -46,6 +47,7 @@ from lynxplan.planning.lanes import (
     pair_along,
 )
 from lynxplan.planning.validity import (
+    PROBES,
     STALL_DISTANCE,
     first_below,
     joint_poses_upto,
@@ -206,38 +208,79 @@ def edge_fraction_from(
     q_b: np.ndarray,
     slack_a: np.ndarray,
     slack_b: np.ndarray,
-    midpoint: bool | np.bool_,
+    points: int,
     model: Any,
     scratch: Any,
     clearance: float,
 ) -> float:
     """:func:`edge_fraction` with the pairs' slacks at q_a and q_b already known (slack_a,
     slack_b (P,), in [m], from :func:`state_slacks` at exactly q_a and q_b: tree nodes',
-    computed once); with ``midpoint``, scratch[18] holds every pair's bound at the edge's
-    midpoint (a quick test :func:`lynxplan.planning.validity.point_is_clear` at s = 0.5 of
-    this edge that passed, just before)."""
+    computed once), and every pair's bound at ``points`` grid points of this edge (grid rows
+    0..points-1: quick tests :func:`lynxplan.planning.validity.point_is_clear` that passed
+    just before, in increasing order of s)."""
     start, end = scratch[4], scratch[19]
     for p in range(start.shape[0]):
         start[p] = slack_a[p]
         end[p] = slack_b[p]
-    grid = END_KNOWN | (MIDPOINT if midpoint else 0)
-    return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(True), grid)
+    return edge_walk(
+        q_a, q_b, model, scratch, clearance, np.bool_(True), END_KNOWN + points * POINT
+    )
 
 
 @njit_no_refcount()
-def edge_is_free_after_midpoint(
+def edge_is_free_after_probes(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
-    """:func:`edge_is_free` right after a quick test of its midpoint passed
-    (:func:`lynxplan.planning.validity.point_is_clear` at s = 0.5: its bounds are in
-    scratch[18])."""
-    walked = edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(MIDPOINT))
+    """:func:`edge_is_free` right after the quick tests
+    :func:`lynxplan.planning.validity.probes_are_clear` of this edge passed (their bounds are
+    the grid)."""
+    walked = edge_walk(
+        q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(PROBES * POINT)
+    )
     return walked >= 1.0
 
 
-#: Flags of :func:`edge_walk`: the pairs' slacks at the edge's end are in scratch[19]; their
-#: bounds at its midpoint are in scratch[18].
-END_KNOWN, MIDPOINT = 1, 2
+#: Flags of :func:`edge_walk`'s ``grid``: the pairs' slacks at the edge's end are in
+#: scratch[19] (END_KNOWN); plus POINT times the number of grid points: every pair's bounds at
+#: them are grid rows scratch[18][i], (P,), at edge parameters scratch[20][i], increasing.
+END_KNOWN, POINT = 1, 2
+
+
+@numba.njit(cache=True, inline="always")
+def _grid_start(
+    p: int, static: float, points: int, model: Any, scratch: Any, clearance: float
+) -> None:
+    """Where pair p's walk starts (scratch[6][p], its slack, lever arms and reach) and the grid
+    point from which the grid certifies it to the edge's end (scratch[21][p]), or nothing to
+    walk (reach infinite), from the two-sided static test (motion bound ``static`` [m] per unit
+    s) on the intervals i = 0..points between the grid points s_{i-1} and s_i (s_{-1} = 0,
+    s_points = 1; :func:`_walk_start`)."""
+    slack, reach, where, all_arms = scratch[4], scratch[5], scratch[6], scratch[15]
+    end, bounds, at, tail = scratch[19], scratch[18], scratch[20], scratch[21]
+    first = last = -1  # the first and the last interval not certified
+    before, sigma = 0.0, slack[p]
+    for i in range(points + 1):
+        u = at[i] if i < points else 1.0
+        sigma_u = bounds[i, p] - clearance if i < points else end[p]
+        passed = sigma + sigma_u > static * (u - before) and (
+            i == points or sigma_u > STALL_DISTANCE
+        )
+        if not passed:
+            last = i
+            if first < 0:
+                first = i
+        before, sigma = u, sigma_u
+    if first < 0:
+        return  # every interval certified
+    if last < points:
+        tail[p] = at[last]
+    if first > 0:  # certified up to grid point first - 1: the walk starts there
+        where[p], slack[p] = at[first - 1], bounds[first - 1, p] - clearance
+        copy_row(all_arms, p, model[9], p)  # lever arms at most the static reach
+        reach[p] = where[p] + reach_step(slack[p], p, all_arms, p, model, scratch)
+        return
+    lever_arms(p, scratch[0], scratch[3], model, all_arms, p)
+    reach[p] = reach_step(slack[p], p, all_arms, p, model, scratch)
 
 
 @numba.njit(cache=True, inline="always")
@@ -256,16 +299,19 @@ def _walk_start(
 
     A pair is certified on the whole edge at once by the static motion bound L (its motion
     over any interval of length ds is at most L ds): one-sided when its slack at q_a is at
-    least L, two-sided when the slacks at both ends sum to more than L, or on both halves when
-    the midpoint's bounds are known (MIDPOINT) and each half's end slacks sum to more than
-    L / 2 (the test of :func:`span_motion` with the static bound). A pair certified on the
-    first half only starts at the midpoint.
+    least L, two-sided when the slacks at both ends sum to more than L, or interval by interval
+    between the edge's ends and the grid points (``grid``)
+    where its bounds are known: two-sided on [s, t] when the slacks at s and t sum to more
+    than L (t - s) (the test of :func:`span_motion` with the static bound). A pair whose
+    intervals pass up to a grid point starts its walk there (scratch[6]); one whose intervals
+    pass from a grid point to the end is certified to the end once its walk reaches that point
+    (scratch[21], infinite when not).
     """
     pairs, rates = model[8], model[9]
     count = pairs.shape[0]
     dq, counters, slack = scratch[14], scratch[9], scratch[4]
-    end, middle = scratch[19], scratch[18]
-    reach, where, all_arms, trend = scratch[5], scratch[6], scratch[15], scratch[16]
+    end, reach, where, trend, tail = scratch[19], scratch[5], scratch[6], scratch[16], scratch[21]
+    points = grid // POINT
     for j in range(q_a.shape[0]):
         dq[j] = abs(q_b[j] - q_a[j])
     counters[0] += 1
@@ -291,19 +337,10 @@ def _walk_start(
         where[p] = 0.0
         trend[p] = 0.0
         reach[p] = np.inf
+        tail[p] = np.inf
         if slack[p] >= static or slack[p] + end[p] > static:
             continue  # certified to s = 1 by the static bound alone
-        if grid & MIDPOINT != 0:
-            mid = middle[p] - clearance
-            if mid > STALL_DISTANCE and slack[p] + mid > 0.5 * static:
-                if mid + end[p] > 0.5 * static:
-                    continue  # both halves certified
-                where[p], slack[p] = 0.5, mid
-                copy_row(all_arms, p, rates, p)  # lever arms at most the static reach
-                reach[p] = 0.5 + reach_step(mid, p, all_arms, p, model, scratch)
-                continue
-        lever_arms(p, scratch[0], scratch[3], model, all_arms, p)
-        reach[p] = reach_step(slack[p], p, all_arms, p, model, scratch)
+        _grid_start(p, static, points, model, scratch, clearance)
     return True
 
 
@@ -478,7 +515,7 @@ def edge_walk(
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
     ``known``, scratch[4] holds the pairs' slacks at q_a; ``grid``: what else is known
-    (:data:`END_KNOWN`, :data:`MIDPOINT`; :func:`_walk_start` certifies most pairs with them).
+    (:data:`END_KNOWN`, grid points; :func:`_walk_start` certifies most pairs with them).
 
     Every pair keeps the last point s_p of the edge where its bound was evaluated, its slack
     sigma_p above the clearance there, and the point it is certified to. The pair certified
@@ -496,7 +533,7 @@ def edge_walk(
     count = model[8].shape[0]
     counters, slack = scratch[9], scratch[4]
     reach, where, arms, all_arms = scratch[5], scratch[6], scratch[13], scratch[15]
-    trend = scratch[16]
+    trend, tail = scratch[16], scratch[21]
     if not _walk_start(q_a, q_b, model, scratch, clearance, known, grid):
         return -1.0
     lanes = model[0].shape[0] <= MAX_JOINTS and q_a.shape[0] <= MAX_JOINTS
@@ -507,6 +544,9 @@ def edge_walk(
                 p, nearest = k, reach[k]
         if nearest >= 1.0:
             return 1.0
+        if nearest >= tail[p]:  # the grid certifies the rest of the edge
+            reach[p] = np.inf
+            continue
         s = where[p]
         # Two-sided step length from the slack's trend (its change per unit s at the last step):
         # the bound's speed V ~ slack / ds; the two ends' slacks sum to about 2 slack + trend t,

@@ -26,6 +26,9 @@ from lynxplan.collision.world import CollisionWorld
 #: of a run on average, so 8 lanes computed about half in vain; 4 gave the fastest planning
 #: (median 1.18 ms against 1.36 ms with 8, 1.27 with 6, 1.42 with 3 and 1.36 with 2).
 LANES = 4
+#: Interior points of an edge at which a walk may know every pair's bound beforehand (the quick
+#: tests before it: :func:`lynxplan.planning.validity.point_is_clear`).
+GRID_POINTS = 7
 #: Obstacle kinds of the kernels.
 OBSTACLE_BOX, OBSTACLE_SPHERE = 0, 1
 
@@ -151,9 +154,10 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
     counters (edge checks, advancement steps, pair bounds evaluated) and the pair that last
     failed a quick state test, the joint and primitive poses at an edge's start, the joints'
     lever arms at two points of an edge, the joint steps of an edge, every pair's lever arms
-    and slack trend on an edge, the output rows of :func:`lynxplan.planning.lanes.pair_along`
-    and every pair's bound at one configuration (the midpoint of the last quick edge test) and
-    slack at an edge's end."""
+    and slack trend on an edge, the output rows of :func:`lynxplan.planning.lanes.pair_along`,
+    every pair's bound at up to :data:`GRID_POINTS` points of an edge (the quick tests before a
+    walk), every pair's slack at an edge's end, the grid points' edge parameters, and the point
+    of an edge from which each pair is certified to its end by the grid."""
     joints, pairs, nq = len(model[0]), len(model[8]), model[9].shape[1]
     return (
         np.empty((joints, 4, 4)),
@@ -174,7 +178,9 @@ def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
         np.empty((pairs, nq)),
         np.empty(pairs),
         np.empty((3 + nq, LANES)),
+        np.empty((GRID_POINTS, pairs)),
         np.empty(pairs),
+        np.empty(GRID_POINTS),
         np.empty(pairs),
     )
 

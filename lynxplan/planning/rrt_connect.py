@@ -39,10 +39,10 @@ from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
     edge_fraction_from,
-    edge_is_free_after_midpoint,
+    edge_is_free_after_probes,
     state_slacks,
 )
-from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
+from lynxplan.planning.kernel_model import GRID_POINTS, njit_no_refcount, njit_refcounted
 from lynxplan.planning.validity import (
     ValidityChecker,
     point_is_clear,
@@ -181,11 +181,11 @@ def _extends(
     """Whether the edge from node ``near`` of ``tree`` to ``new`` (nq,; its slacks: fresh
     (P,)) is certified whole (a blocked extension is usually blocked at its midpoint: that
     quick test first; its bounds then serve the walk)."""
-    if not point_is_clear(nodes[tree, near], new, 0.5, model, scratch, clearance):
+    if not point_is_clear(nodes[tree, near], new, 0.5, model, scratch, clearance, np.int64(0)):
         return False
     start = _slacks(nodes, slacks, known, tree, near, model, scratch, clearance)
     reached = edge_fraction_from(
-        nodes[tree, near], new, start, fresh, np.bool_(True), model, scratch, clearance
+        nodes[tree, near], new, start, fresh, np.int64(1), model, scratch, clearance
     )
     return bool(reached >= 1.0)
 
@@ -207,27 +207,34 @@ def _connect(
     connection adds nodes there).
 
     The piece points are tested first (quick state tests, in order): the walk then covers the
-    edge only up to the last point that passes, whose bounds it reuses, and is skipped when the
-    first one fails. ahead: (2, P) work rows.
+    edge only up to the last point that passes, is skipped when the first one fails, and uses
+    the passed points' bounds as its grid (up to :data:`GRID_POINTS` of them). ahead: (2, P)
+    work rows.
     """
     clear = pieces
+    wide = pieces - 1 > GRID_POINTS  # more points than grid rows: no grid
     for k in range(1, pieces):
-        if not point_is_clear(base, new, k / pieces, model, scratch, clearance):
+        if not point_is_clear(
+            base, new, k / pieces, model, scratch, clearance, 0 if wide else k - 1
+        ):
             clear = k - 1
             break
-        ahead[0] = scratch[18]
+        if wide:
+            ahead[0] = scratch[18][0]
     if clear == 0:
         return 0.0
-    if clear == pieces:  # two pieces: the one point tested is the midpoint
-        scratch[18][:] = ahead[0]
-        return edge_fraction_from(base, new, start, fresh, pieces == 2, model, scratch, clearance)
+    if clear == pieces:
+        points = 0 if wide else pieces - 1
+        return edge_fraction_from(base, new, start, fresh, points, model, scratch, clearance)
     fraction = clear / pieces
     target = base + fraction * (new - base)
     for p in range(ahead.shape[1]):
-        ahead[1, p] = ahead[0, p] - clearance
-    reached = edge_fraction_from(
-        base, target, start, ahead[1], np.bool_(False), model, scratch, clearance
-    )
+        ahead[1, p] = (ahead[0, p] if wide else scratch[18][clear - 1, p]) - clearance
+    # the grid points before the last one that passed, as fractions of the shorter edge
+    points = 0 if wide else clear - 1
+    for k in range(points):
+        scratch[20][k] = (k + 1) / clear
+    reached = edge_fraction_from(base, target, start, ahead[1], points, model, scratch, clearance)
     return fraction * reached if reached < 1.0 else fraction
 
 
@@ -328,7 +335,7 @@ def straight_goal(
     for k in range(goals.shape[0]):
         if probes_are_clear(
             start, goals[k], model, scratch, clearance
-        ) and edge_is_free_after_midpoint(start, goals[k], model, scratch, clearance):
+        ) and edge_is_free_after_probes(start, goals[k], model, scratch, clearance):
             return k
     return -1
 

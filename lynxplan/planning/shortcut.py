@@ -40,10 +40,11 @@ from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
     copy_row,
     edge_fraction_from,
-    edge_is_free_after_midpoint,
+    edge_is_free_after_probes,
 )
 from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
 from lynxplan.planning.validity import (
+    PROBES,
     ValidityChecker,
     point_is_clear,
     probes_are_clear,
@@ -127,7 +128,7 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
                 start = _slacks_at(path, i, slacks, known, model, scratch, clearance)
                 end = _slacks_at(path, j, slacks, known, model, scratch, clearance)
                 reached = edge_fraction_from(
-                    path[i], path[j], start, end, np.bool_(True), model, scratch, clearance
+                    path[i], path[j], start, end, np.int64(PROBES), model, scratch, clearance
                 )
                 if reached >= 1.0:
                     break
@@ -149,17 +150,20 @@ def _segments_free(
     pairs = model[8].shape[0]
     middle = np.empty((max(size - 1, 0), pairs))
     for k in range(size - 1):
-        if not point_is_clear(points[k], points[k + 1], 0.5, model, scratch, clearance):
+        if not point_is_clear(
+            points[k], points[k + 1], 0.5, model, scratch, clearance, np.int64(0)
+        ):
             return False
-        middle[k] = scratch[18]
+        middle[k] = scratch[18][0]
     slacks = np.empty((size, pairs))
     known = np.zeros(size, dtype=np.bool_)
     for k in range(size - 1):
         start = _slacks_at(points, k, slacks, known, model, scratch, clearance)
         end = _slacks_at(points, k + 1, slacks, known, model, scratch, clearance)
-        scratch[18][:] = middle[k]
+        scratch[18][0] = middle[k]
+        scratch[20][0] = 0.5
         reached = edge_fraction_from(
-            points[k], points[k + 1], start, end, np.bool_(True), model, scratch, clearance
+            points[k], points[k + 1], start, end, np.int64(1), model, scratch, clearance
         )
         if reached < 1.0:
             return False
@@ -218,7 +222,7 @@ def _full(
     if i1 == i2 or count + 2 > path.shape[0]:
         return 0
     if not probes_are_clear(first, second, model, scratch, clearance) or (
-        not edge_is_free_after_midpoint(first, second, model, scratch, clearance)
+        not edge_is_free_after_probes(first, second, model, scratch, clearance)
     ):
         return 0
     # path[..i1], first, second, path[i2+1..] (np.int64: no extra compile for a literal 2)
@@ -458,7 +462,7 @@ def shortcut_kernel(
     while k < count - 1:
         if probes_are_clear(
             path[k - 1], path[k + 1], model, scratch, clearance
-        ) and edge_is_free_after_midpoint(path[k - 1], path[k + 1], model, scratch, clearance):
+        ) and edge_is_free_after_probes(path[k - 1], path[k + 1], model, scratch, clearance):
             for m in range(k, count - 1):
                 path[m] = path[m + 1]
             count -= 1

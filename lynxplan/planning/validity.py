@@ -307,7 +307,7 @@ def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> No
 @njit_no_refcount()
 def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
     """Smallest pair bound at q (nq,), in [m] (inf without pairs)."""
-    bounds = scratch[18]
+    bounds = scratch[18][0]
     state_bounds(q, model, scratch, bounds)
     best = np.inf
     for p in range(bounds.shape[0]):
@@ -335,32 +335,46 @@ def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: 
 
 @njit_no_refcount()
 def point_is_clear(
-    q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any, clearance: float
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    s: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    row: int,
 ) -> bool:
     """Whether every pair's bound exceeds clearance + STALL_DISTANCE at q_a + s (q_b - q_a).
 
     A quick rejection before an edge walk (a blocked edge usually has a blocked point there):
     it stops at the first failing pair, trying first the pair that failed last (scratch[9][3]).
+    When it passes, the edge walk may use its bounds: they are in grid row ``row``
+    (scratch[18][row], (P,), in [m]; the point's parameter s in scratch[20][row]).
     """
     q = scratch[7]
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-    return first_below(q, model, scratch, clearance + STALL_DISTANCE, scratch[18]) == -1
+    scratch[20][row] = s
+    return first_below(q, model, scratch, clearance + STALL_DISTANCE, scratch[18][row]) == -1
 
 
 @numba.njit(cache=True, inline="always")
 def probes_are_clear(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
-    """:func:`point_is_clear` at s = 1/4, 3/4, then 1/2 of the edge (the midpoint's bounds are
-    then in scratch[18], for :func:`lynxplan.planning.edge_walk.edge_is_free_after_midpoint`).
+    """:func:`point_is_clear` at s = 1/4, 3/4, then 1/2 of the edge (their bounds are then grid
+    rows 0, 2 and 1: the walk's grid of :data:`PROBES` points, for
+    :func:`lynxplan.planning.edge_walk.edge_is_free_after_probes`).
 
     Before an edge walk whose only use is a whole certified edge (a shortcut, the straight
     edge to a goal): a blocked edge is usually blocked at one of these points, and a test
     there costs one configuration's bounds, where the walk would advance to the obstacle
-    first."""
+    first. A pair far enough from everything is then certified by the grid alone."""
     return (
-        point_is_clear(q_a, q_b, 0.25, model, scratch, clearance)
-        and point_is_clear(q_a, q_b, 0.75, model, scratch, clearance)
-        and point_is_clear(q_a, q_b, 0.5, model, scratch, clearance)
+        point_is_clear(q_a, q_b, 0.25, model, scratch, clearance, np.int64(0))
+        and point_is_clear(q_a, q_b, 0.75, model, scratch, clearance, np.int64(2))
+        and point_is_clear(q_a, q_b, 0.5, model, scratch, clearance, np.int64(1))
     )
+
+
+#: Grid points that :func:`probes_are_clear` leaves for the edge walk.
+PROBES = 3
