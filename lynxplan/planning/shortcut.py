@@ -21,7 +21,8 @@ Five passes over a piecewise-linear joint path, all with the planner's validity 
    (a fraction ``partial`` of the attempts) a partial cut of one joint drawn in proportion to
    its excess motion (total variation beyond its net displacement). The cuts stop after
    ``patience`` attempts in a row that changed nothing.
-5. *Vertex pruning*: a waypoint whose two neighbours see each other is removed.
+5. *Vertex shortcuts* again (as 1.): the cuts leave corners on the old path's segments, and
+   most of them see past their neighbours.
 
 A cut is kept when it shortens the path (a partial cut by at least :data:`MIN_GAIN`) and every
 new edge is certified. The parts of the old path kept around a cut are pieces of certified
@@ -414,7 +415,7 @@ def shortcut_kernel(
 ) -> int:
     """Greedy vertex shortcuts (if ``greedy``), goal switch, one-joint straightening over
     ``levels`` levels, random full and partial cuts (a fraction ``partial`` of the attempts)
-    then vertex pruning, in place on path[:count]; returns the new count.
+    then greedy vertex shortcuts, in place on path[:count]; returns the new count.
 
     path: (capacity, nq); a cut adds at most two rows, and none is made once the capacity is
     reached (count + 2 * (iterations + nq * (2^levels - 1)) suffices); work: same shape. The
@@ -458,17 +459,7 @@ def shortcut_kernel(
         size = _full(path, count, cumulative, u1, u2, model, scratch, clearance, work, piece)
         if size > 0:
             count, idle = size, 0
-    k = 1
-    while k < count - 1:
-        if probes_are_clear(
-            path[k - 1], path[k + 1], model, scratch, clearance
-        ) and edge_is_free_after_probes(path[k - 1], path[k + 1], model, scratch, clearance):
-            for m in range(k, count - 1):
-                path[m] = path[m + 1]
-            count -= 1
-        else:
-            k += 1
-    return count
+    return _greedy(path, count, model, scratch, clearance)
 
 
 def merge_collinear(path: np.ndarray) -> np.ndarray:
