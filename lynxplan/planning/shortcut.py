@@ -18,9 +18,9 @@ Five passes over a piecewise-linear joint path, all with the planner's validity 
    tries to remove goes here in one try per joint.
 4. *Random shortcuts* between two random points of the path by arc length (anywhere on its
    segments, not only at waypoints): a *full* cut, the straight edge between the points, or
-   (a fraction ``partial`` of the attempts) a partial cut of one joint drawn in proportion to
-   its excess motion (total variation beyond its net displacement). The cuts stop after
-   ``patience`` attempts in a row that changed nothing.
+   (a fraction ``partial`` of the attempts, none by default) a partial cut of one joint drawn in
+   proportion to its excess motion (total variation beyond its net displacement). The cuts
+   stop after ``patience`` attempts in a row that changed nothing.
 5. *Vertex shortcuts* again (as 1.): the cuts leave corners on the old path's segments, and
    most of them see past their neighbours.
 
@@ -55,9 +55,13 @@ from lynxplan.planning.validity import (
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
 #: Random cuts stop after this many attempts in a row that changed nothing.
-DEFAULT_SHORTCUT_PATIENCE = 5
-#: Fraction of the random attempts that are partial (one-joint) shortcuts.
-DEFAULT_PARTIAL_FRACTION = 0.5
+DEFAULT_SHORTCUT_PATIENCE = 7
+#: Fraction of the random attempts that are partial (one-joint) shortcuts. None by default:
+#: after the one-joint straightening, full cuts with a little more patience give paths as short
+#: (AL5 suite, 20 seeds: total of the median lengths 31.22 rad against 31.16 with half of the
+#: attempts partial and a patience of 5) in less time (the shortcut stage ~60 us less at the
+#: median): a partial cut certifies every segment it spans, a full cut one edge.
+DEFAULT_PARTIAL_FRACTION = 0.0
 #: Joints that move less than this beyond their net displacement get no partial shortcut, [rad].
 WANDER_TOLERANCE = 1e-3
 #: A partial shortcut must shorten the path by at least this, in [rad].

@@ -19,8 +19,11 @@ PROBLEMS = [p for p in SUITE if p.stem.startswith(("p02", "p08"))]
 
 
 @pytest.mark.parametrize("path", PROBLEMS, ids=[p.stem for p in PROBLEMS])
-@pytest.mark.parametrize("greedy", [True, False])
-def test_shortcut_keeps_the_path_certified_and_shorter(path: object, greedy: bool) -> None:
+@pytest.mark.parametrize(("greedy", "partial"), [(True, 0.0), (False, 0.0), (True, 0.5)])
+def test_shortcut_keeps_the_path_certified_and_shorter(
+    path: object, greedy: bool, partial: float
+) -> None:
+    """With and without the first greedy pass, and with random partial (one-joint) cuts."""
     problem = load_problem(path)
     planner = Planner(problem.robot, problem.obstacles, problem.options)
     goals = goal_configurations(problem.robot, planner.space, problem.goal).configurations
@@ -30,8 +33,8 @@ def test_shortcut_keeps_the_path_certified_and_shorter(path: object, greedy: boo
         raw = rrt_connect(
             checker, space.lower, space.upper, problem.start, goals, seed=seed, time_limit=5.0
         ).path
-        short = shortcut(checker, raw, seed=seed, greedy=greedy)
-        again = shortcut(checker, raw, seed=seed, greedy=greedy)
+        short = shortcut(checker, raw, seed=seed, greedy=greedy, partial=partial)
+        again = shortcut(checker, raw, seed=seed, greedy=greedy, partial=partial)
         assert np.array_equal(short, again)
         np.testing.assert_array_equal(short[0], raw[0])
         np.testing.assert_array_equal(short[-1], raw[-1])
