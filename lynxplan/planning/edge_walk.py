@@ -272,8 +272,7 @@ def _grid_start(
         before, sigma = u, sigma_u
     if first < 0:
         return  # every interval certified
-    if last < points:
-        tail[p] = at[last]
+    tail[p] = at[last] if last < points else np.inf
     if first > 0:  # certified up to grid point first - 1: the walk starts there
         where[p], slack[p] = at[first - 1], bounds[first - 1, p] - clearance
         copy_row(all_arms, p, model[9], p)  # lever arms at most the static reach
@@ -310,7 +309,7 @@ def _walk_start(
     pairs, rates = model[8], model[9]
     count = pairs.shape[0]
     dq, counters, slack = scratch[14], scratch[9], scratch[4]
-    end, reach, where, trend, tail = scratch[19], scratch[5], scratch[6], scratch[16], scratch[21]
+    end, reach, where, trend = scratch[19], scratch[5], scratch[6], scratch[16]
     points = grid // POINT
     for j in range(q_a.shape[0]):
         dq[j] = abs(q_b[j] - q_a[j])
@@ -337,7 +336,6 @@ def _walk_start(
         where[p] = 0.0
         trend[p] = 0.0
         reach[p] = np.inf
-        tail[p] = np.inf
         if slack[p] >= static or slack[p] + end[p] > static:
             continue  # certified to s = 1 by the static bound alone
         _grid_start(p, static, points, model, scratch, clearance)
