@@ -68,6 +68,10 @@ WANDER_TOLERANCE = 1e-3
 MIN_GAIN = 1e-3
 #: Levels of the one-joint straightening pass (:func:`_flatten`): whole path, halves, ...
 FLATTEN_LEVELS = 1
+#: The one-joint straightening keeps a cut only when it shortens the path by at least this
+#: fraction of its length: most of its cuts that gain less are of joints that carry the arm
+#: around an obstacle (a shoulder), whose certification costs as much as a useful one.
+FLATTEN_MIN_GAIN = 0.02
 #: Points closer than this in joint space are merged, in [rad].
 _MERGE_DISTANCE = 1e-9
 
@@ -271,11 +275,12 @@ def _partial(
     clearance: float,
     work: np.ndarray,
     piece: np.ndarray,
+    gain: float,
 ) -> int:
     """Partial shortcut of one joint (Geraerts & Overmars 2007): between the points at arc
     lengths u1 < u2, that joint moves linearly in the arc length while the others keep their
-    motion. Applied in place when it shortens the path and every new edge is certified; returns
-    the new count, or 0 when nothing changed."""
+    motion. Applied in place when it shortens the path by at least ``gain`` [rad] and every new
+    edge is certified; returns the new count, or 0 when nothing changed."""
     first, second = piece[0], piece[1]
     i1 = _point_at(path, cumulative, count, u1, first)
     i2 = _point_at(path, cumulative, count, u2, second)
@@ -296,7 +301,7 @@ def _partial(
     length = 0.0
     for k in range(size - 1):
         length += _distance(points[k], points[k + 1])
-    if length >= (u2 - u1) - MIN_GAIN:
+    if length >= (u2 - u1) - gain:
         return 0
     if not _segments_free(points, size, model, scratch, clearance):
         return 0
@@ -341,6 +346,7 @@ def _flatten(
                     clearance,
                     work,
                     piece,
+                    max(MIN_GAIN, FLATTEN_MIN_GAIN * total),
                 )
                 if size > 0:
                     count = size
@@ -455,7 +461,18 @@ def shortcut_kernel(
             if joint < 0:
                 continue
             size = _partial(
-                path, count, cumulative, u1, u2, joint, model, scratch, clearance, work, piece
+                path,
+                count,
+                cumulative,
+                u1,
+                u2,
+                joint,
+                model,
+                scratch,
+                clearance,
+                work,
+                piece,
+                MIN_GAIN,
             )
             if size > 0:
                 count, idle = size, 0
