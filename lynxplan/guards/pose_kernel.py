@@ -34,35 +34,38 @@ def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.nda
     detail is then the largest deviation of a rotation block from orthonormal (0 with
     ``approach_only``).
 
-    A first pass without early exits (vectorised) checks every pose; only when one fails does
-    the second pass look for the first bad one."""
+    A first pass without early exits or a floating-point reduction (vectorised: each pose's
+    deviation to a row, their largest found on the bit patterns, whose integer order is the
+    order of non-negative floats) checks every pose; only when one fails does the second pass
+    look for the first bad one."""
     out = np.zeros(3)
+    deviations = np.empty(T.shape[0])  # 0 with approach_only
     good = True
-    worst = 0.0
     for k in range(T.shape[0]):
-        t = T[k]
-        r0 = (t[0, 0] + t[0, 1]) + (t[0, 2] + t[0, 3])
-        r1 = (t[1, 0] + t[1, 1]) + (t[1, 2] + t[1, 3])
-        r2 = (t[2, 0] + t[2, 1]) + (t[2, 2] + t[2, 3])
-        r3 = (t[3, 0] + t[3, 1]) + (t[3, 2] + t[3, 3])
+        r0 = (T[k, 0, 0] + T[k, 0, 1]) + (T[k, 0, 2] + T[k, 0, 3])
+        r1 = (T[k, 1, 0] + T[k, 1, 1]) + (T[k, 1, 2] + T[k, 1, 3])
+        r2 = (T[k, 2, 0] + T[k, 2, 1]) + (T[k, 2, 2] + T[k, 2, 3])
+        r3 = (T[k, 3, 0] + T[k, 3, 1]) + (T[k, 3, 2] + T[k, 3, 3])
         nan = ((r0 + r1) + (r2 + r3)) * 0.0  # NaN when an element is not finite
-        far = max(abs(t[0, 3]), abs(t[1, 3]), abs(t[2, 3]))
-        bottom = max(abs(t[3, 0]), abs(t[3, 1]), abs(t[3, 2]), abs(t[3, 3] - 1.0))
+        far = max(abs(T[k, 0, 3]), abs(T[k, 1, 3]), abs(T[k, 2, 3]))
+        bottom = max(abs(T[k, 3, 0]), abs(T[k, 3, 1]), abs(T[k, 3, 2]), abs(T[k, 3, 3] - 1.0))
         if approach_only:
-            deviation = abs(t[0, 2] ** 2 + t[1, 2] ** 2 + t[2, 2] ** 2 - 1.0)
+            deviation = abs(T[k, 0, 2] ** 2 + T[k, 1, 2] ** 2 + T[k, 2, 2] ** 2 - 1.0)
             det = 1.0
         else:
             deviation = 0.0
             for i in range(3):
                 for j in range(i, 3):  # R^T R is symmetric
-                    dot = t[0, i] * t[0, j] + t[1, i] * t[1, j] + t[2, i] * t[2, j]
+                    dot = (
+                        T[k, 0, i] * T[k, 0, j] + T[k, 1, i] * T[k, 1, j] + T[k, 2, i] * T[k, 2, j]
+                    )
                     deviation = max(deviation, abs(dot - (1.0 if i == j else 0.0)))
             det = (
-                t[0, 0] * (t[1, 1] * t[2, 2] - t[1, 2] * t[2, 1])
-                - t[0, 1] * (t[1, 0] * t[2, 2] - t[1, 2] * t[2, 0])
-                + t[0, 2] * (t[1, 0] * t[2, 1] - t[1, 1] * t[2, 0])
+                T[k, 0, 0] * (T[k, 1, 1] * T[k, 2, 2] - T[k, 1, 2] * T[k, 2, 1])
+                - T[k, 0, 1] * (T[k, 1, 0] * T[k, 2, 2] - T[k, 1, 2] * T[k, 2, 0])
+                + T[k, 0, 2] * (T[k, 1, 0] * T[k, 2, 1] - T[k, 1, 1] * T[k, 2, 0])
             )
-            worst = max(worst, deviation)
+        deviations[k] = 0.0 if approach_only else deviation
         good &= (
             (nan == 0.0)
             & (far <= max_length)
@@ -70,8 +73,12 @@ def _pose_check(T: np.ndarray, max_length: float, approach_only: bool) -> np.nda
             & (deviation <= RIGIDITY_REPAIR_TOLERANCE)
             & (det >= 0.0)
         )
-    if good:
-        out[2] = worst
+    if good:  # every deviation finite and >= 0: the largest bit pattern is the largest value
+        bits = deviations.view(np.int64)
+        top = np.int64(0)
+        for k in range(bits.size):
+            top = max(top, bits[k])
+        out.view(np.int64)[2] = top
         return out
     worst = 0.0
     for k in range(T.shape[0]):
