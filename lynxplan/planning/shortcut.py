@@ -323,10 +323,19 @@ def _flatten(
     """Partial shortcuts of each joint over the whole path, then over its halves, ... (``levels``
     levels: 2^level equal parts of the arc length at level ``level``), in place on
     path[:count]; returns the new count. A joint that wanders over the whole path (a wrist roll
-    that turns away and back) is straightened in one try instead of many random ones."""
+    that turns away and back) is straightened in one try instead of many random ones. The joints
+    go in order of their motion beyond their net displacement, largest first (the largest gains
+    first; the joints tried later then move less)."""
+    nq = path.shape[1]
+    excess = np.empty(nq)  # each joint's motion beyond its net displacement: largest first
+    for j in range(nq):
+        excess[j] = -abs(path[count - 1, j] - path[0, j])
+        for k in range(1, count):
+            excess[j] += abs(path[k, j] - path[k - 1, j])
+    order = np.argsort(-excess)
     for level in range(levels):
         parts = 2**level
-        for joint in range(path.shape[1]):
+        for joint in order:
             for part in range(parts):
                 if count < 3:
                     return count
