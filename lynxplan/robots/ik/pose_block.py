@@ -52,16 +52,13 @@ from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
 from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
 from lynxplan.robots.ik.pose_kernel import (
     AXIAL_APPROACH,
-    ORIENTATION_ERROR,
     POSE_EXACT,
-    POSITION_ERROR,
     REACH_MISS,
     SLOT_COLUMNS,
-    VALID,
-    WITHIN,
     polish_pose,
     smallest_error,
     solve_target,
+    write_slots,
     yaw_match,
 )
 
@@ -1068,12 +1065,5 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             prm, placements, axes, targets[n], ref, out,
             g, pose, work, qs, jac, origins, normal, vectors,
         )  # fmt: skip
-        for b in range(nb):
-            for j in range(5):
-                q_out[n, b, j] = out[b, j]
-            valid[n, b] = out[b, VALID] != 0.0
-            within[n, b] = out[b, WITHIN] != 0.0
-            position_error[n, b] = out[b, POSITION_ERROR]
-            orientation_error[n, b] = out[b, ORIENTATION_ERROR]
-        distance[n] = smallest_error(position_error, n)
+        write_slots(out, n, q_out, valid, within, position_error, orientation_error, distance)
     return fallbacks + deferred_count

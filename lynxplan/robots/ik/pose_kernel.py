@@ -378,6 +378,29 @@ def smallest_error(errors: np.ndarray, n: int) -> float:
     return best
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def write_slots(
+    out: np.ndarray,
+    n: int,
+    q_out: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+    distance: np.ndarray,
+) -> None:
+    """Target n's slots from :func:`solve_target`'s rows ``out`` (B, SLOT_COLUMNS) into the
+    batch outputs (see :func:`pose_kernel`), and its smallest position error."""
+    for b in range(q_out.shape[1]):
+        for j in range(5):
+            q_out[n, b, j] = out[b, j]
+        valid[n, b] = out[b, VALID] != 0.0
+        within[n, b] = out[b, WITHIN] != 0.0
+        position_error[n, b] = out[b, POSITION_ERROR]
+        orientation_error[n, b] = out[b, ORIENTATION_ERROR]
+    distance[n] = smallest_error(position_error, n)
+
+
 @numba.njit(cache=True, nogil=True)
 def pose_kernel(
     prm: np.ndarray,
@@ -430,11 +453,4 @@ def pose_kernel(
             normal,
             vectors,
         )
-        for b in range(nb):
-            for j in range(5):
-                q_out[n, b, j] = out[b, j]
-            valid[n, b] = out[b, VALID] != 0.0
-            within[n, b] = out[b, WITHIN] != 0.0
-            position_error[n, b] = out[b, POSITION_ERROR]
-            orientation_error[n, b] = out[b, ORIENTATION_ERROR]
-        distance[n] = smallest_error(position_error, n)
+        write_slots(out, n, q_out, valid, within, position_error, orientation_error, distance)
