@@ -11,11 +11,12 @@ Five passes over a piecewise-linear joint path, all with the planner's validity 
    joint during the whole motion instead of at the end.
 3. *One-joint straightening*: a *partial* cut (Geraerts & Overmars 2007) moves one joint
    linearly in the arc length between two points of the path while the others keep their
-   motion; it is tried for every joint over the whole path (:data:`FLATTEN_LEVELS` > 1: then
-   over its halves, ...). RRT-Connect's random samples make joints that matter little for
-   collisions (a wrist roll) wander, and a straight cut of all joints rarely removes that where
-   the others must go around an obstacle: most of the length the random cuts would take many
-   tries to remove goes here in one try per joint.
+   motion; it is tried for every joint over the whole path, the most wandering joint first
+   (:data:`FLATTEN_LEVELS` > 1: then over its halves, ...), and kept when it gains at least
+   :data:`FLATTEN_MIN_GAIN` of the path's length. RRT-Connect's random samples make joints
+   that matter little for collisions (a wrist roll) wander, and a straight cut of all joints
+   rarely removes that where the others must go around an obstacle: most of the length the
+   random cuts would take many tries to remove goes here in one try per joint.
 4. *Random shortcuts* between two random points of the path by arc length (anywhere on its
    segments, not only at waypoints): a *full* cut, the straight edge between the points, or
    (a fraction ``partial`` of the attempts, none by default) a partial cut of one joint drawn in
@@ -24,10 +25,10 @@ Five passes over a piecewise-linear joint path, all with the planner's validity 
 5. *Vertex shortcuts* again (as 1.): the cuts leave corners on the old path's segments, and
    most of them see past their neighbours.
 
-A cut is kept when it shortens the path (a partial cut by at least :data:`MIN_GAIN`) and every
-new edge is certified. The parts of the old path kept around a cut are pieces of certified
-edges: the path stays valid after every change ("verify after every shortcut" — pyroboplan's
-``shortcut_path`` does not, and returns paths through obstacles).
+A cut is kept when it shortens the path (a random partial cut by at least :data:`MIN_GAIN`)
+and every new edge is certified. The parts of the old path kept around a cut are pieces of
+certified edges: the path stays valid after every change ("verify after every shortcut" —
+pyroboplan's ``shortcut_path`` does not, and returns paths through obstacles).
 """
 
 from __future__ import annotations

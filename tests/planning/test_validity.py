@@ -88,3 +88,34 @@ def test_turning_the_base_joint_near_the_base_takes_few_steps(arm: Arm) -> None:
     assert counters[1] < 40
     s = np.linspace(0.0, 1.0, 50)
     assert world.distances(q_a + s[:, None] * (q_b - q_a)).min() >= 0.002
+
+
+def test_whole_edges_certified_from_the_probes_grid_are_free(
+    arm: Arm, world: CollisionWorld
+) -> None:
+    """An edge that passes the quarter probes and is then walked with their bounds as a grid
+    (pairs certified interval by interval, walks that start and stop at grid points) is free at
+    a dense set of exact checks."""
+    from lynxplan.planning.edge_walk import edge_is_free_after_probes
+    from lynxplan.planning.validity import probes_are_clear
+
+    checker = ValidityChecker(world, 0.002)
+    model, scratch = checker.model, checker.scratch
+    rng = np.random.default_rng(3)
+    certified = rejected = 0
+    for _ in range(300):
+        q_a = rng.uniform(arm.limits.lower, arm.limits.upper)
+        q_b = np.clip(q_a + rng.normal(scale=0.8, size=5), arm.limits.lower, arm.limits.upper)
+        if not (checker.is_valid(q_a) and checker.is_valid(q_b)):
+            continue
+        free = probes_are_clear(q_a, q_b, model, scratch, 0.002) and edge_is_free_after_probes(
+            q_a, q_b, model, scratch, 0.002
+        )
+        if not free:
+            rejected += 1
+            continue
+        certified += 1
+        s = np.linspace(0.0, 1.0, 200)
+        distances = world.distances(q_a + s[:, None] * (q_b - q_a))
+        assert distances.min() >= 0.002 - BOUND_TOLERANCE, (q_a.tolist(), q_b.tolist())
+    assert certified > 10 and rejected > 10
