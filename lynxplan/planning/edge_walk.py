@@ -199,7 +199,9 @@ def edge_fraction(
 
     Returns -1 if q_a itself is not valid (:func:`edge_walk`).
     """
-    return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0))
+    return edge_walk(
+        q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0), np.int64(ALL_JOINTS)
+    )
 
 
 @njit_no_refcount()
@@ -212,18 +214,22 @@ def edge_fraction_from(
     model: Any,
     scratch: Any,
     clearance: float,
+    moved: int,
 ) -> float:
     """:func:`edge_fraction` with the pairs' slacks at q_a and q_b already known (slack_a,
     slack_b (P,), in [m], from :func:`state_slacks` at exactly q_a and q_b: tree nodes',
     computed once), and every pair's bound at ``points`` grid points of this edge (grid rows
     0..points-1: quick tests :func:`lynxplan.planning.validity.point_is_clear` that passed
-    just before, in increasing order of s)."""
+    just before, in increasing order of s).
+
+    ``moved``: the joints (bit j: joint j) in which the edge may differ from a certified one
+    (:func:`edge_walk`), or :data:`ALL_JOINTS`."""
     start, end = scratch[4], scratch[19]
     for p in range(start.shape[0]):
         start[p] = slack_a[p]
         end[p] = slack_b[p]
     return edge_walk(
-        q_a, q_b, model, scratch, clearance, np.bool_(True), END_KNOWN + points * POINT
+        q_a, q_b, model, scratch, clearance, np.bool_(True), END_KNOWN + points * POINT, moved
     )
 
 
@@ -235,10 +241,22 @@ def edge_is_free_after_probes(
     :func:`lynxplan.planning.validity.probes_are_clear` of this edge passed (their bounds are
     the grid)."""
     walked = edge_walk(
-        q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(PROBES * POINT)
+        q_a,
+        q_b,
+        model,
+        scratch,
+        clearance,
+        np.bool_(False),
+        np.int64(PROBES * POINT),
+        np.int64(ALL_JOINTS),
     )
     return walked >= 1.0
 
+
+#: :func:`edge_walk`'s ``moved`` when the edge is new in every joint.
+ALL_JOINTS = -1
+#: Joints with a bit of their own in ``moved``; any joint beyond them stands for all.
+_JOINT_BITS = 62
 
 #: Flags of :func:`edge_walk`'s ``grid``: the pairs' slacks at the edge's end are in
 #: scratch[19] (END_KNOWN); plus POINT times the number of grid points: every pair's bounds at
@@ -283,6 +301,23 @@ def _grid_start(
 
 
 @numba.njit(cache=True, inline="always")
+def joint_bit(j: int) -> int:
+    """Joint j as a bit set for ``moved`` (:func:`edge_walk`)."""
+    bit: int = np.int64(1) << j if j < _JOINT_BITS else np.int64(ALL_JOINTS)
+    return bit
+
+
+@numba.njit(cache=True, inline="always")
+def _moves(p: int, moved: int, rates: np.ndarray) -> bool:
+    """Whether a joint of the bit set ``moved`` (not :data:`ALL_JOINTS`) changes pair p's
+    distance (its motion rate about that joint, rates (P, nq), is not zero)."""
+    for j in range(min(rates.shape[1], _JOINT_BITS)):
+        if (moved >> j) & 1 and rates[p, j] > 0.0:
+            return True
+    return False
+
+
+@numba.njit(cache=True, inline="always")
 def _walk_start(
     q_a: np.ndarray,
     q_b: np.ndarray,
@@ -291,6 +326,7 @@ def _walk_start(
     clearance: float,
     known: bool | np.bool_,
     grid: int,
+    moved: int,
 ) -> bool:
     """Set up an edge walk: joint steps, every pair's slack at q_a (unless ``known``) and at
     q_b (unless ``grid`` has END_KNOWN), first one-sided reach; False when a pair is within
@@ -304,7 +340,8 @@ def _walk_start(
     than L (t - s) (the test of :func:`span_motion` with the static bound). A pair whose
     intervals pass up to a grid point starts its walk there (scratch[6]); one whose intervals
     pass from a grid point to the end is certified to the end once its walk reaches that point
-    (scratch[21], infinite when not).
+    (scratch[21], infinite when not). A pair that no joint of ``moved`` moves (:func:`edge_walk`)
+    is certified at once.
     """
     pairs, rates = model[8], model[9]
     count = pairs.shape[0]
@@ -338,6 +375,8 @@ def _walk_start(
         reach[p] = np.inf
         if slack[p] >= static or slack[p] + end[p] > static:
             continue  # certified to s = 1 by the static bound alone
+        if moved != ALL_JOINTS and not _moves(p, moved, rates):
+            continue  # the same motion as on the certified edge
         _grid_start(p, static, points, model, scratch, clearance)
     return True
 
@@ -510,10 +549,19 @@ def edge_walk(
     clearance: float,
     known: bool | np.bool_,
     grid: int,
+    moved: int,
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
     ``known``, scratch[4] holds the pairs' slacks at q_a; ``grid``: what else is known
     (:data:`END_KNOWN`, grid points; :func:`_walk_start` certifies most pairs with them).
+
+    ``moved``: :data:`ALL_JOINTS`, or a bit set of joints (bit j: joint j) when the caller
+    knows that in every other joint the edge runs along a certified edge: its configurations,
+    in those joints, are those of the certified edge (a piece of an edge of a valid path with
+    only these joints changed, as a partial shortcut makes). A pair that none of these joints
+    moves (its motion rate about each is zero: its distance depends on the other joints only)
+    then has the distances it had there, all above the clearance: it is certified without a
+    walk.
 
     Every pair keeps the last point s_p of the edge where its bound was evaluated, its slack
     sigma_p above the clearance there, and the point it is certified to. The pair certified
@@ -532,7 +580,7 @@ def edge_walk(
     counters, slack = scratch[9], scratch[4]
     reach, where, arms, all_arms = scratch[5], scratch[6], scratch[13], scratch[15]
     trend, tail = scratch[16], scratch[21]
-    if not _walk_start(q_a, q_b, model, scratch, clearance, known, grid):
+    if not _walk_start(q_a, q_b, model, scratch, clearance, known, grid, moved):
         return -1.0
     lanes = model[0].shape[0] <= MAX_JOINTS and q_a.shape[0] <= MAX_JOINTS
     while True:
@@ -580,4 +628,7 @@ def edge_is_free(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
     """Whether the whole edge from q_a to q_b is certified (:func:`edge_fraction`)."""
-    return edge_walk(q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0)) >= 1.0
+    walked = edge_walk(
+        q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0), np.int64(ALL_JOINTS)
+    )
+    return walked >= 1.0

@@ -38,6 +38,7 @@ from lynxplan._jit import compile_before_timing
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
+    ALL_JOINTS,
     edge_fraction_from,
     edge_is_free_after_probes,
     state_slacks,
@@ -185,7 +186,15 @@ def _extends(
         return False
     start = _slacks(nodes, slacks, known, tree, near, model, scratch, clearance)
     reached = edge_fraction_from(
-        nodes[tree, near], new, start, fresh, np.int64(1), model, scratch, clearance
+        nodes[tree, near],
+        new,
+        start,
+        fresh,
+        np.int64(1),
+        model,
+        scratch,
+        clearance,
+        np.int64(ALL_JOINTS),
     )
     return bool(reached >= 1.0)
 
@@ -225,7 +234,9 @@ def _connect(
         return 0.0
     if clear == pieces:
         points = 0 if wide else pieces - 1
-        return edge_fraction_from(base, new, start, fresh, points, model, scratch, clearance)
+        return edge_fraction_from(
+            base, new, start, fresh, points, model, scratch, clearance, np.int64(ALL_JOINTS)
+        )
     fraction = clear / pieces
     target = base + fraction * (new - base)
     for p in range(ahead.shape[1]):
@@ -234,7 +245,9 @@ def _connect(
     points = 0 if wide else clear - 1
     for k in range(points):
         scratch[20][k] = (k + 1) / clear
-    reached = edge_fraction_from(base, target, start, ahead[1], points, model, scratch, clearance)
+    reached = edge_fraction_from(
+        base, target, start, ahead[1], points, model, scratch, clearance, np.int64(ALL_JOINTS)
+    )
     return fraction * reached if reached < 1.0 else fraction
 
 
@@ -340,14 +353,37 @@ def straight_goal(
     return -1
 
 
-def _branch(parents: np.ndarray, tree: int, index: int) -> list[int]:
-    """Node indices from ``index`` up to its tree's root (parents: (2, M), root parent -1)."""
-    branch = []
-    row = parents[tree]
-    while index >= 0:
-        branch.append(index)
-        index = row.item(index)
-    return branch
+@njit_refcounted()
+def _solution(nodes: np.ndarray, parents: np.ndarray, meta: np.ndarray) -> tuple[np.ndarray, int]:
+    """The path through the joined trees: tree 0 from its root to node meta[1], then tree 1
+    from node meta[2] to its root (nodes (2, M, nq), parents (2, M), root parent -1), without
+    repeated points (the joint nodes coincide); and the tree-1 root it ends at."""
+    nq = nodes.shape[2]
+    depth = np.zeros(2, dtype=np.int64)
+    for tree in range(2):
+        index = meta[1 + tree]
+        while index >= 0:
+            depth[tree] += 1
+            index = parents[tree, index]
+    path = np.empty((depth[0] + depth[1], nq))
+    index = meta[1]
+    for k in range(depth[0] - 1, -1, -1):  # tree 0: root first
+        path[k] = nodes[0, index]
+        index = parents[0, index]
+    index, root = meta[2], meta[2]
+    for k in range(depth[0], depth[0] + depth[1]):
+        path[k] = nodes[1, index]
+        root = index
+        index = parents[1, index]
+    count = 1
+    for k in range(1, path.shape[0]):
+        gap = 0.0
+        for j in range(nq):
+            gap += (path[k, j] - path[count - 1, j]) ** 2
+        if math.sqrt(gap) > 1e-12:
+            path[count] = path[k]
+            count += 1
+    return path[:count].copy(), int(root)
 
 
 #: Nodes each tree has room for at first; the arrays double when a kernel call might fill them.
@@ -430,6 +466,7 @@ def rrt_connect(
     # the first call in a process: compile (or load) the kernels outside the time limit
     began += compile_before_timing(straight_goal, (start, goals, model, scratch, clearance))
     began += compile_before_timing(rrt_connect_kernel, arguments(trees))
+    began += compile_before_timing(_solution, (nodes, parents, meta))
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.vstack([start, goals[k]])
@@ -455,11 +492,7 @@ def rrt_connect(
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
-    to_goal = _branch(parents, 1, int(meta[2]))
-    path = np.concatenate([nodes[0, _branch(parents, 0, int(meta[1]))[::-1]], nodes[1, to_goal]])
-    keep = np.ones(len(path), dtype=bool)
-    keep[1:] = np.linalg.norm(np.diff(path, axis=0), axis=1) > 1e-12
-    goal_index = to_goal[-1]  # the goal tree's root the branch hangs on
+    path, goal_index = _solution(nodes, parents, meta)
     return RrtConnectResult(
-        path[keep], goal_index, int(counts.sum()), int(meta[3]), time.perf_counter() - began
+        path, goal_index, int(counts.sum()), int(meta[3]), time.perf_counter() - began
     )

@@ -40,9 +40,11 @@ import numpy as np
 
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
+    ALL_JOINTS,
     copy_row,
     edge_fraction_from,
     edge_is_free_after_probes,
+    joint_bit,
 )
 from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
 from lynxplan.planning.validity import (
@@ -138,7 +140,15 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
                 start = _slacks_at(path, i, slacks, known, model, scratch, clearance)
                 end = _slacks_at(path, j, slacks, known, model, scratch, clearance)
                 reached = edge_fraction_from(
-                    path[i], path[j], start, end, np.int64(PROBES), model, scratch, clearance
+                    path[i],
+                    path[j],
+                    start,
+                    end,
+                    np.int64(PROBES),
+                    model,
+                    scratch,
+                    clearance,
+                    np.int64(ALL_JOINTS),
                 )
                 if reached >= 1.0:
                     break
@@ -152,11 +162,15 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
 
 @numba.njit(cache=True)
 def _segments_free(
-    points: np.ndarray, size: int, model: Any, scratch: Any, clearance: float
+    points: np.ndarray, size: int, model: Any, scratch: Any, clearance: float, moved: int
 ) -> bool:
     """Whether every straight edge between consecutive rows of points[:size] is certified
     (quick midpoint tests of all edges first: a blocked edge is usually blocked there; their
-    bounds then serve the walks, and so do the points' slacks, each computed once)."""
+    bounds then serve the walks, and so do the points' slacks, each computed once).
+
+    moved: the joints (bit j: joint j) in which the edges differ from pieces of certified
+    edges (the path's, before a partial cut or a goal switch changed those joints), or
+    ALL_JOINTS (:func:`lynxplan.planning.edge_walk.edge_walk`)."""
     pairs = model[8].shape[0]
     middle = np.empty((max(size - 1, 0), pairs))
     for k in range(size - 1):
@@ -173,7 +187,7 @@ def _segments_free(
         scratch[18][0] = middle[k]
         scratch[20][0] = 0.5
         reached = edge_fraction_from(
-            points[k], points[k + 1], start, end, np.int64(1), model, scratch, clearance
+            points[k], points[k + 1], start, end, np.int64(1), model, scratch, clearance, moved
         )
         if reached < 1.0:
             return False
@@ -304,7 +318,8 @@ def _partial(
         length += _distance(points[k], points[k + 1])
     if length >= (u2 - u1) - gain:
         return 0
-    if not _segments_free(points, size, model, scratch, clearance):
+    # In the other joints, each new edge runs along a piece of an edge of the path.
+    if not _segments_free(points, size, model, scratch, clearance, joint_bit(joint)):
         return 0
     return _splice(path, count, i1, i2, points, size, work)
 
@@ -408,7 +423,12 @@ def _switch_goal(
             length += _distance(piece[k - 1], piece[k])
         if not inside or length >= old - MIN_GAIN:
             continue
-        if _segments_free(piece, count, model, scratch, clearance):
+        moved = np.int64(0)  # the joints the switch changes; the others keep the path's edges
+        for k in range(count):
+            for j in range(nq):
+                if piece[k, j] != path[k, j]:
+                    moved |= joint_bit(j)
+        if _segments_free(piece, count, model, scratch, clearance, moved):
             for k in range(count):
                 path[k] = piece[k]
             return int(g)

@@ -90,3 +90,41 @@ def test_span_and_step_bounds_cover_the_real_motion(arm: Arm, checker: ValidityC
             tight += bound < 0.8 * static
     assert tested > 200
     assert tight > tested // 5  # the lever arms are tighter than the static reach
+
+
+def test_a_pair_with_a_zero_rate_about_a_joint_keeps_its_exact_distance_when_it_turns(
+    arm: Arm, checker: ValidityChecker
+) -> None:
+    """The edge walk certifies a pair without a walk when the edge differs from a certified one
+    only in joints whose motion rate for the pair is zero (a partial shortcut's joint): the
+    pair's exact distance (coal) must then not depend on those joints at all. And the rates
+    that are not zero must belong to joints that do change some distance (the test can fail)."""
+    obstacles = [BoxObstacle("box", [0.2, 0.1, 0.05], [0.05, 0.3, 0.2])]
+    world = CollisionWorld(arm, obstacles, self_collision=True)
+    world_rows = {
+        (int(a), int(b), int(s)): k
+        for k, (a, b, s) in enumerate(
+            zip(world.pair_link, world.pair_other, world.pair_is_self, strict=True)
+        )
+    }
+    rows = [world_rows[tuple(int(v) for v in row)] for row in checker.model[8]]
+    rates = checker.model[9]
+    rng = np.random.default_rng(11)
+    lower, upper = np.asarray(arm.limits.lower), np.asarray(arm.limits.upper)
+    changed = np.zeros_like(rates, dtype=bool)
+    for _ in range(30):
+        q = rng.uniform(lower, upper)
+        before = world.primitive_poses(q[None])[0]
+        for j in range(len(q)):
+            turned = q.copy()
+            turned[j] = rng.uniform(lower[j], upper[j])
+            after = world.primitive_poses(turned[None])[0]
+            for p, k in enumerate(rows):
+                d0, d1 = world.distance(before, k), world.distance(after, k)
+                if rates[p, j] == 0.0:
+                    assert abs(d1 - d0) <= 1e-6, (checker.pair_names[p], j, d0, d1)
+                elif abs(d1 - d0) > 1e-6:
+                    changed[p, j] = True
+    # Rates are conservative (a primitive turning about its own axis of symmetry has one), but
+    # most of them must show in the distances.
+    assert changed[rates > 0.0].mean() > 0.8
