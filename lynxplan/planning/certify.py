@@ -36,6 +36,7 @@ import numba
 import numpy as np
 
 from lynxplan.planning.edge_walk import (
+    MAX_GROWTH,
     STEP_GROWTH,
     copy_row,
     farthest_lane,
@@ -270,7 +271,7 @@ def _chain(
     static = 0.0
     for j in range(q_a.shape[0]):
         static += model[9][p, j] * scratch[14][j]
-    s, b = 0.0, ends[0]
+    s, b, trend = 0.0, ends[0], 0.0  # trend: the bound's change per unit s at the last step
     pose_pair_at(q_a, q_b, 0.0, p, model, scratch, 0)  # its lever arms (b: the caller's)
     while True:
         if count >= pair.shape[0]:
@@ -283,7 +284,13 @@ def _chain(
             motion[count - 1] = static * (1.0 - s)
             s, b = 1.0, ends[1]
             continue
-        t = min(1.0, s + STEP_GROWTH * reach_step(b, p, arms, 0, model, scratch))
+        # the walk's step (edge_walk): longer while the bound grows, down to one-sided steps
+        # as it closes in at the speed its one-sided step assumes
+        one = reach_step(b, p, arms, 0, model, scratch)
+        speed = b / one
+        closing = speed - min(max(trend, -speed), speed)
+        step = STEP_GROWTH * b / closing if closing > 0.0 else MAX_GROWTH * one
+        t = min(1.0, s + min(step, MAX_GROWTH * one))
         while True:  # halve the step until the two-sided test passes (one inlined bound)
             bt = _bound_at(q_a, q_b, t, p, model, scratch, 1)
             span = span_motion(p, t - s, model, scratch)
@@ -295,6 +302,7 @@ def _chain(
             s, b = 1.0, ends[1]
             continue
         motion[count - 1] = span
+        trend = (bt - b) / (t - s)
         s, b = t, bt
         copy_row(arms, 0, arms, 1)
 
