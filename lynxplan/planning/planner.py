@@ -22,7 +22,7 @@ from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
 from lynxplan.planning.shortcut import (
     DEFAULT_SHORTCUT_ITERATIONS,
-    shortcut_kernel,
+    shortcut_path,
     shortcut_to_goals,
 )
 from lynxplan.planning.space import JointSpace
@@ -214,7 +214,7 @@ class Planner:
         and verification kernels before the clock starts, on a path that stays at q (nq,), a
         valid configuration: their run is trivial, their compile is not. (RRT-Connect compiles
         its own kernel outside its time limit.)"""
-        if shortcut_kernel.overloads and schedule.overloads:  # (.signatures: ~20 us each)
+        if shortcut_path.overloads and schedule.overloads:  # (.signatures: ~20 us each)
             return
         path = np.vstack([q, q])
         lower, upper = self.space.lower, self.space.upper

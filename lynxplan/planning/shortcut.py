@@ -38,6 +38,7 @@ from typing import Any, NamedTuple
 import numba
 import numpy as np
 
+from lynxplan._arrays import kernel_input
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
     ALL_JOINTS,
@@ -513,14 +514,6 @@ def shortcut_kernel(
     return _greedy(path, count, model, scratch, clearance)
 
 
-def merge_collinear(path: np.ndarray) -> np.ndarray:
-    """The path without waypoints that lie on the straight line of their neighbours (RRT-Connect
-    adds one every step along a connection): the same straight segments, fewer waypoints."""
-    keep = np.empty(len(path), dtype=np.int64)
-    merged: np.ndarray = path[keep[: _collinear_kernel(path, keep)]]
-    return merged
-
-
 @numba.njit(cache=True)
 def _collinear_kernel(path: np.ndarray, keep: np.ndarray) -> int:
     """Indices of the waypoints to keep -> keep[:count]; returns count."""
@@ -611,31 +604,76 @@ def shortcut_to_goals(
     that shortens it (another IK branch or roll of a pose goal), within the joint limits
     ``lower``, ``upper`` (nq,), in [rad].
     """
-    path = merge_collinear(path)
-    count = len(path)
-    capacity = count + 2 * (iterations + path.shape[1] * (2**levels - 1)) + 2
-    buffer = np.zeros((capacity, path.shape[1]))
-    buffer[:count] = path
-    work = np.zeros_like(buffer)
-    goal = np.array([goal_index], dtype=np.int64)
-    bounds = np.vstack([lower, upper]).astype(float)
     # A stream of its own: the planner's draws and the shortcutter's never overlap.
     state = _rng.seed_state(seed ^ 0x5DEECE66D)
+    shortened, goal = shortcut_path(
+        kernel_input(np.asarray(path, dtype=float)),
+        kernel_input(np.asarray(goals, dtype=float)),
+        goal_index,
+        kernel_input(np.asarray(lower, dtype=float)),
+        kernel_input(np.asarray(upper, dtype=float)),
+        state,
+        iterations,
+        patience,
+        greedy,
+        partial,
+        levels,
+        checker.model,
+        checker.scratch,
+        checker.clearance,
+    )
+    return ShortcutResult(shortened, int(goal))
+
+
+@numba.njit(cache=True)
+def shortcut_path(
+    path: np.ndarray,
+    goals: np.ndarray,
+    goal_index: int,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    state: np.ndarray,
+    iterations: int,
+    patience: int,
+    greedy: bool,
+    partial: float,
+    levels: int,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+) -> tuple[np.ndarray, int]:
+    """:func:`shortcut_to_goals` in one compiled call (the Python steps around the kernel
+    cost more than their work between compiled calls): the path (N, nq) without its collinear
+    waypoints (RRT-Connect adds one every step along a connection), copied into work arrays
+    with room for every cut, :func:`shortcut_kernel`; returns the new path (M, nq) and the index
+    of the goal it ends at. state: random state (1,) uint64, advanced."""
+    keep = np.empty(path.shape[0], dtype=np.int64)
+    count = _collinear_kernel(path, keep)
+    nq = path.shape[1]
+    capacity = count + 2 * (iterations + nq * (2**levels - 1)) + 2
+    buffer = np.zeros((capacity, nq))
+    for k in range(count):
+        copy_row(buffer, k, path, keep[k])
+    work = np.zeros_like(buffer)
+    goal = np.full(1, goal_index, dtype=np.int64)
+    bounds = np.empty((2, nq))
+    for j in range(nq):
+        bounds[0, j], bounds[1, j] = lower[j], upper[j]
     count = shortcut_kernel(
         buffer,
         count,
         iterations,
         state,
-        checker.model,
-        checker.scratch,
-        checker.clearance,
+        model,
+        scratch,
+        clearance,
         work,
         patience,
         greedy,
         partial,
-        np.ascontiguousarray(goals, dtype=float),
+        goals,
         goal,
         bounds,
         levels,
     )
-    return ShortcutResult(buffer[:count].copy(), int(goal[0]))
+    return buffer[:count].copy(), int(goal[0])
