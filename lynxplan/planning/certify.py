@@ -497,3 +497,37 @@ def verification_rows(
         path, segment[which], parameter[which], pair[which], model, scratch, rotation, translation
     )
     return count, queries
+
+
+@numba.njit(cache=True)
+def row_distances(
+    exact: np.ndarray,
+    lookup: np.ndarray,
+    segment: np.ndarray,
+    parameter: np.ndarray,
+    motion: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
+    """The scheduled rows' exact distances and what they prove, in one call.
+
+    exact: (Q,) the queries' distances, in [m]; lookup, segment, parameter, motion: (R,) the
+    rows' columns (:func:`verification_rows`). Returns each row's distance (R,) (its query's),
+    its path parameter (R,) (segment + s), the first row whose distance is <= 0 (a contact; -1
+    when none), and the rows r (increasing) whose interval to the next row of their chain the
+    exact distances do not prove: ``motion[r] >= 0`` and ``d_r + d_{r+1} <= motion[r]``.
+    """
+    rows = lookup.shape[0]
+    distance = np.empty(rows)
+    where = np.empty(rows)
+    contact = -1
+    for r in range(rows):
+        distance[r] = exact[lookup[r]]
+        where[r] = segment[r] + parameter[r]
+        if contact < 0 and distance[r] <= 0.0:
+            contact = r
+    fails = np.empty(max(rows - 1, 0), dtype=np.int64)
+    count = 0
+    for r in range(rows - 1):
+        if motion[r] >= 0.0 and distance[r] + distance[r + 1] <= motion[r]:
+            fails[count] = r
+            count += 1
+    return distance, where, contact, fails[:count]

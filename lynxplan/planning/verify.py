@@ -39,6 +39,7 @@ from lynxplan.collision import ClearanceRecord, CollisionWorld
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
 from lynxplan.planning.certify import (
     configuration_poses,
+    row_distances,
     row_transforms,
     segment_rates,
     verification_rows,
@@ -330,19 +331,19 @@ class _PathCheck:
         planned = verifier.schedule(path)
         segment, parameter, pair, motion = planned[:4]
         exact = verifier.exact_posed(planned.query_pair, planned.rotation, planned.translation)
-        distance = exact[planned.lookup]  # a row at an earlier row's configuration: its distance
-        bounds, poses = planned.bounds, planned.poses
-        self.where, self.pair, self.distance = segment + parameter, pair, distance
-        if distance.size and distance.min() <= 0.0:
-            r = int(np.argmax(distance <= 0.0))
-            self._report_contact(float(self.where[r]), int(pair[r]), float(distance[r]))
+        # a row at an earlier row's configuration has its distance; the chains' failed tests
+        distance, where, contact, fails = row_distances(
+            exact, planned.lookup, segment, parameter, motion
+        )
+        self.where, self.pair, self.distance = where, pair, distance
+        if contact >= 0:
+            r = contact
+            self._report_contact(float(where[r]), int(pair[r]), float(distance[r]))
             return
-        self._waypoint_minimum(bounds, poses)
-        if self.contact is not None or len(pair) < 2:
+        self._waypoint_minimum(planned.bounds, planned.poses)
+        if self.contact is not None:
             return
-        # Consecutive rows of one chain: every row but a chain's last has a motion bound >= 0.
-        fails = (motion[:-1] >= 0.0) & (distance[:-1] + distance[1:] <= motion[:-1])
-        for r in np.flatnonzero(fails).tolist():
+        for r in fails.tolist():
             self.bisect(int(segment[r]), int(pair[r]), float(parameter[r]), float(parameter[r + 1]))
             if self.contact is not None or not self.certified:
                 return
