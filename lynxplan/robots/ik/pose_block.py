@@ -181,10 +181,14 @@ def _yaw(
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # noqa: PLR0915
+def _flip(  # noqa: PLR0915
+    pr: Floats, shape: Floats, t: Floats, flip: int, on_roll_axis: bool
+) -> FlipBranches:
     """One flip of the yaw (both elbows) of the target t (12: row-major 3 x 4) on the ideal
     model: (its geometry, where ``_branches`` finds the angles, candidate, fallback, side, near
-    a fold of the elbow); shape: (la, lb, b2, b3) of the two links
+    a fold of the elbow); on_roll_axis: the tool point on the roll axis (``F.OFF_AXIS`` 0: the
+    roll is then the side's; a constant, so the roll of the other kind is not computed at all);
+    shape: (la, lb, b2, b3) of the two links
     (``family_geometry.two_link``), sin, cos and the angle gamma0, sin and cos of b2 and of
     b2 - b3.
 
@@ -237,9 +241,8 @@ def _flip(pr: Floats, shape: Floats, t: Floats, flip: int) -> FlipBranches:  # n
     phi2 = yaw1 if ok1 else yaw0
     s2, c2 = (s_yaw1, c_yaw1) if ok1 else (s_yaw0, c_yaw0)
     _, sp, cp, flat2 = _pitch_sum(shape, a_h, a_p, a_k, s2, c2)
-    st2, ct2 = _roll_terms(pr, g, s2, c2, sp, cp)  # a tool on the roll axis: of the side's yaw
-    on_roll_axis = pr[F.OFF_AXIS] == 0.0
-    st, ct = (st2, ct2) if on_roll_axis else (st, ct)
+    if on_roll_axis:  # a tool on the roll axis: the roll of the side's yaw
+        st, ct = _roll_terms(pr, g, s2, c2, sp, cp)
     x, y = c2 * dh - s2 * dp, dk
     wh = pr[F.W0] + ct * pr[F.E1] + st * pr[F.E2]
     wk = pr[F.W0 + 1] + ct * pr[F.E1 + 1] + st * pr[F.E2 + 1]
@@ -576,6 +579,20 @@ def _rotation_angle(p: Floats, t: Floats) -> float:
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
 def _closed_forms(pr: Floats, shape: Floats, x: np.ndarray) -> None:
+    """``_closed_forms_of`` for a tool point off the roll axis (``F.OFF_AXIS`` not 0)."""
+    wide_vectors()
+    _closed_forms_of(pr, shape, x, False)
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _closed_forms_on_roll_axis(pr: Floats, shape: Floats, x: np.ndarray) -> None:
+    """``_closed_forms_of`` for a tool point on the roll axis (``F.OFF_AXIS`` 0)."""
+    wide_vectors()
+    _closed_forms_of(pr, shape, x, True)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _closed_forms_of(pr: Floats, shape: Floats, x: np.ndarray, on_roll_axis: bool) -> None:
     """Both flips and elbows of the block's poses in the scratch rows (x[: _ROWS * BLOCK], row
     k at x[k * BLOCK:]), and pose i's first candidate flip (flip 0 where it is a candidate, else
     flip 1) in the candidate rows (x[_ROWS * BLOCK:], row k at x[_ROWS * BLOCK + k * _CW:]):
@@ -584,12 +601,11 @@ def _closed_forms(pr: Floats, shape: Floats, x: np.ndarray) -> None:
     docstring); one array at distances LLVM sees, so it needs no aliasing checks. The loop runs
     over the whole block (in a last block of fewer poses, the rows past them hold earlier poses
     or zeros, their results unused): with a constant count LLVM sees that no store reaches a
-    target."""
-    wide_vectors()
+    target. on_roll_axis: a constant (``_flip``), one compiled loop for each kind of tool."""
     for i in range(BLOCK):
         t = _column_of(x, BLOCK, 0, i)
-        first = _flip(pr, shape, t, 0)
-        other = _flip(pr, shape, t, 1)
+        first = _flip(pr, shape, t, 0, on_roll_axis)
+        other = _flip(pr, shape, t, 1, on_roll_axis)
         _put_flip(x, i, 0, first)
         _put_flip(x, i, 1, other)
         pick = first[1]  # flip 0 where it is a candidate (selects, scalar by scalar)
@@ -870,6 +886,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     ch = _chain_tuple(placements, axes)
     pr: Floats = to_fixed_tuple(prm, _N_PRM)  # type: ignore[call-arg]
     exact = prm[F.EXACT] != 0.0
+    on_roll_axis = prm[F.OFF_AXIS] == 0.0
     lower, upper, tol = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5], prm[F.LIMIT_TOL]
     l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
@@ -910,7 +927,10 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             for r in range(3):
                 for col in range(4):
                     s[4 * r + col, i] = targets[start + i, r, col]
-        _closed_forms(pr, shape, x_flat)
+        if on_roll_axis:
+            _closed_forms_on_roll_axis(pr, shape, x_flat)
+        else:
+            _closed_forms(pr, shape, x_flat)
         # the candidates of the poses that need no fallback, in the scalar solver's order: lane
         # i the elbow up and lane BLOCK + i the elbow down of pose i's first candidate flip
         # (written by _closed_forms), then the other flip where it is a candidate too (rare:
