@@ -54,7 +54,7 @@ robot.ik_batch(poses[:10])
 robot.ik(position=poses[0, :3, 3], approach=poses[0, :3, 2])
 
 kernels = {
-    "rrt_connect_kernel": rrt_connect.rrt_connect_kernel,
+    "rrt_connect_begin": rrt_connect.rrt_connect_begin,
     "shortcut_path": shortcut.shortcut_path,
     "verification_rows": certify.verification_rows,
     "ik_kernel": ik_kernel.ik_kernel,
@@ -96,7 +96,7 @@ def test_each_big_kernel_has_one_compiled_signature() -> None:
     assert done.returncode == 0, done.stderr[-3000:]
     counts = json.loads(done.stdout.strip().splitlines()[-2])
     assert all(count <= 1 for count in counts.values()), counts
-    for name in ("rrt_connect_kernel", "shortcut_path", "ik_kernel", "ik_single_kernel"):
+    for name in ("rrt_connect_begin", "shortcut_path", "ik_kernel", "ik_single_kernel"):
         assert counts[name] == 1, counts  # used by the workload
     # Inside compiled code a constant argument is a literal type (a literal 0 or 2 where the
     # callee also gets an int64 compiles it twice: the certification's chain took 15 s a time).

@@ -499,7 +499,7 @@ def verification_rows(
     return count, queries
 
 
-@numba.njit(cache=True)
+@njit_refcounted()
 def row_distances(
     exact: np.ndarray,
     lookup: np.ndarray,

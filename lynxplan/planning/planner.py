@@ -10,7 +10,7 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, cast
 
 import numpy as np
 
@@ -214,7 +214,7 @@ class Planner:
         and verification kernels before the clock starts, on a path that stays at q (nq,), a
         valid configuration: their run is trivial, their compile is not. (RRT-Connect compiles
         its own kernel outside its time limit.)"""
-        if shortcut_path.overloads and schedule.overloads:  # (.signatures: ~20 us each)
+        if cast(Any, shortcut_path).overloads and schedule.overloads:  # (.signatures: ~20 us each)
             return
         path = np.vstack([q, q])
         lower, upper = self.space.lower, self.space.upper

@@ -386,6 +386,75 @@ def _solution(nodes: np.ndarray, parents: np.ndarray, meta: np.ndarray) -> tuple
     return path[:count].copy(), int(root)
 
 
+@njit_refcounted()
+def rrt_connect_begin(
+    start: np.ndarray,
+    goals: np.ndarray,
+    capacity: int,
+    lower: np.ndarray,
+    upper: np.ndarray,
+    step: float,
+    goal_bias: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    state: np.ndarray,
+    iterations: int,
+) -> tuple[Any, ...]:
+    """The straight edge to a goal, else the trees and their first ``iterations`` iterations,
+    in one compiled call (the Python steps they replace cost more than their work between
+    compiled calls).
+
+    start: (nq,); goals: (K, nq), the roots of tree 1; capacity: rows of each tree. Returns
+    (status, path, goal index, nodes, parents, slacks, known, counts, roots, meta), the arrays
+    as :func:`rrt_connect_kernel` takes them; the path (N, nq) and its goal (a root of tree 1)
+    when the status is SOLVED, else an empty path and -1.
+    """
+    nq, count = start.shape[0], goals.shape[0]
+    nodes = np.empty((2, capacity, nq))
+    parents = np.empty((2, capacity), dtype=np.int64)  # rows written before they are read
+    slacks = np.empty((2, capacity, model[8].shape[0]))  # filled on first use (known)
+    known = np.zeros((2, capacity), dtype=np.int8)
+    for j in range(nq):
+        nodes[0, 0, j] = start[j]
+    parents[0, 0] = -1
+    for k in range(count):
+        for j in range(nq):
+            nodes[1, k, j] = goals[k, j]
+        parents[1, k] = -1
+    counts = np.array([1, count], dtype=np.int64)
+    roots = counts.copy()
+    meta = np.array([0, -1, -1, 0], dtype=np.int64)
+    k = straight_goal(start, goals, model, scratch, clearance)
+    if k >= 0:  # the straight edge first: free space needs no tree
+        path = np.empty((2, nq))
+        for j in range(nq):
+            path[0, j], path[1, j] = start[j], goals[k, j]
+        return SOLVED, path, k, nodes, parents, slacks, known, counts, roots, meta
+    status = rrt_connect_kernel(
+        lower,
+        upper,
+        step,
+        goal_bias,
+        model,
+        scratch,
+        clearance,
+        nodes,
+        parents,
+        counts,
+        roots,
+        state,
+        meta,
+        iterations,
+        slacks,
+        known,
+    )
+    if status == SOLVED:
+        path, goal = _solution(nodes, parents, meta)
+        return status, path, goal, nodes, parents, slacks, known, counts, roots, meta
+    return status, np.empty((0, nq)), -1, nodes, parents, slacks, known, counts, roots, meta
+
+
 #: Nodes each tree has room for at first; the arrays double when a kernel call might fill them.
 INITIAL_CAPACITY = 4096
 
@@ -439,59 +508,53 @@ def rrt_connect(
         PlanningFailed: the time limit [s] or the node budget was reached first.
     """
     began = time.perf_counter()
-    nq = lower.size
     limit = settings.max_nodes + 1
     # Trees grow in blocks (a budget of 10^7 nodes must not reserve gigabytes up front); one
     # kernel call adds at most CHUNK_ITERATIONS * (1 + pieces of the longest connect) nodes.
     per_call = CHUNK_ITERATIONS * (
         2 + math.ceil(float(np.linalg.norm(upper - lower)) / settings.step)
     )
-    trees = _Trees.empty(min(limit, INITIAL_CAPACITY), nq, len(checker.pair_names))
-    nodes, parents = trees.nodes, trees.parents
-    parents[0, 0] = -1
-    parents[1, : len(goals)] = -1
-    counts = np.array([1, len(goals)], dtype=np.int64)
-    nodes[0, 0] = start
-    nodes[1, : len(goals)] = goals
-    roots = counts.copy()
+    capacity = min(limit, INITIAL_CAPACITY)
+    if capacity < limit and len(goals) + per_call >= capacity:
+        capacity = min(limit, max(2 * capacity, len(goals) + per_call + 1))
     state = _rng.seed_state(seed)
-    meta = np.array([0, -1, -1, 0], dtype=np.int64)
     model, scratch, clearance = checker.model, checker.scratch, checker.clearance
     fixed = (lower, upper, settings.step, settings.goal_bias, model, scratch, clearance)
+    first = (start, goals, capacity, *fixed, state, CHUNK_ITERATIONS)
+    # the first call in a process: compile (or load) the kernel outside the time limit
+    began += compile_before_timing(rrt_connect_begin, first)
+    status, path, goal_index, *arrays = rrt_connect_begin(*first)
+    trees = _Trees(*arrays[:4])
+    counts, roots, meta = arrays[4:]
+    if status == SOLVED:  # the straight edge to a goal, or found in the first iterations
+        return RrtConnectResult(
+            path, int(goal_index), int(counts.sum()), int(meta[3]), time.perf_counter() - began
+        )
+    nodes, parents = trees.nodes, trees.parents
 
     def arguments(trees: _Trees) -> tuple[Any, ...]:
         nodes, parents, slacks, known = trees
         return (*fixed, nodes, parents, counts, roots, state, meta, CHUNK_ITERATIONS, slacks, known)
 
-    # the first call in a process: compile (or load) the kernels outside the time limit
-    began += compile_before_timing(straight_goal, (start, goals, model, scratch, clearance))
     began += compile_before_timing(rrt_connect_kernel, arguments(trees))
     began += compile_before_timing(_solution, (nodes, parents, meta))
-    k = straight_goal(start, goals, model, scratch, clearance)
-    if k >= 0:  # the straight edge first: free space needs no tree
-        path = np.vstack([start, goals[k]])
-        return RrtConnectResult(path, k, int(counts.sum()), 0, time.perf_counter() - began)
-    while True:
-        capacity = nodes.shape[1]
-        if capacity < limit and int(counts.max()) + per_call >= capacity:
-            trees = trees.grown(min(limit, max(2 * capacity, int(counts.max()) + per_call + 1)))
-            nodes, parents = trees.nodes, trees.parents
-        status = rrt_connect_kernel(*arguments(trees))
+    while status != SOLVED:
         elapsed = time.perf_counter() - began
-        if status == SOLVED:
-            break
-        if status == NODE_LIMIT and nodes.shape[1] < limit:  # not the budget: grow, go on
-            trees = trees.grown(min(limit, 2 * nodes.shape[1]))
-            nodes, parents = trees.nodes, trees.parents
-            continue
-        if status == NODE_LIMIT:
+        if status == NODE_LIMIT and nodes.shape[1] >= limit:
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes} reached"
             )
-        if elapsed >= time_limit:
+        if status == NODE_LIMIT:  # not the budget: grow, go on
+            trees = trees.grown(min(limit, 2 * nodes.shape[1]))
+        elif elapsed >= time_limit:
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
+        capacity = trees.nodes.shape[1]
+        if capacity < limit and int(counts.max()) + per_call >= capacity:
+            trees = trees.grown(min(limit, max(2 * capacity, int(counts.max()) + per_call + 1)))
+        nodes, parents = trees.nodes, trees.parents
+        status = rrt_connect_kernel(*arguments(trees))
     path, goal_index = _solution(nodes, parents, meta)
     return RrtConnectResult(
         path, goal_index, int(counts.sum()), int(meta[3]), time.perf_counter() - began

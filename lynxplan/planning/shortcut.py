@@ -1,4 +1,4 @@
-"""Path shortcutting and smoothing, compiled with numba; every change is re-validated.
+"""Path shortcutting and smoothing, compiled with numba; every change is certified.
 
 Five passes over a piecewise-linear joint path, all with the planner's validity checker:
 
@@ -29,6 +29,12 @@ A cut is kept when it shortens the path (a random partial cut by at least :data:
 and every new edge is certified. The parts of the old path kept around a cut are pieces of
 certified edges: the path stays valid after every change ("verify after every shortcut" —
 pyroboplan's ``shortcut_path`` does not, and returns paths through obstacles).
+
+The input path's edges must be certified by the same checker (RRT-Connect's are): a partial
+cut or a goal switch changes some joints only, and the pairs that none of them moves keep the
+distances they had on the path's edges (:func:`lynxplan.planning.edge_walk.edge_walk`'s
+``moved``), so only the others are walked again. (Waypoints closer than 1e-9 rad are merged:
+the kept edges are the certified ones to that tolerance, about 1e-9 m at the arm's reach.)
 """
 
 from __future__ import annotations
@@ -517,6 +523,10 @@ def shortcut_kernel(
 @numba.njit(cache=True)
 def _collinear_kernel(path: np.ndarray, keep: np.ndarray) -> int:
     """Indices of the waypoints to keep -> keep[:count]; returns count."""
+    if path.shape[0] <= 2:  # nothing between the ends
+        for k in range(path.shape[0]):
+            keep[k] = k
+        return int(path.shape[0])
     count = 1
     keep[0] = 0
     nq = path.shape[1]
@@ -552,8 +562,8 @@ def shortcut(
     partial: float = DEFAULT_PARTIAL_FRACTION,
     levels: int = FLATTEN_LEVELS,
 ) -> np.ndarray:
-    """Shortcut and smooth a valid path (N, nq), in [rad]; returns a new (M, nq) path with the
-    same ends.
+    """Shortcut and smooth a path (N, nq), in [rad], whose edges the checker certifies (as the
+    planner's are); returns a new (M, nq) path with the same ends, certified too.
 
     Deterministic for a given ``seed``; one-joint straightening over ``levels`` levels (0:
     none), then at most ``iterations`` random cuts, a fraction ``partial`` of them one-joint
@@ -609,7 +619,7 @@ def shortcut_to_goals(
     shortened, goal = shortcut_path(
         kernel_input(np.asarray(path, dtype=float)),
         kernel_input(np.asarray(goals, dtype=float)),
-        goal_index,
+        int(goal_index),
         kernel_input(np.asarray(lower, dtype=float)),
         kernel_input(np.asarray(upper, dtype=float)),
         state,
@@ -625,7 +635,7 @@ def shortcut_to_goals(
     return ShortcutResult(shortened, int(goal))
 
 
-@numba.njit(cache=True)
+@njit_refcounted()
 def shortcut_path(
     path: np.ndarray,
     goals: np.ndarray,

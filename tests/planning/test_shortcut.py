@@ -101,3 +101,12 @@ def test_one_joint_straightening_removes_wander() -> None:
         full_only += excess(shortcut(planner.checker, raw.path, seed=seed, partial=0.0, levels=0))
         partial += excess(shortcut(planner.checker, raw.path, seed=seed))
     assert partial < 0.5 * full_only
+
+
+def test_paths_of_one_or_two_waypoints_come_back_unchanged() -> None:
+    """Nothing to cut: a single configuration stays one row, a straight edge two."""
+    problem = load_problem(PROBLEMS[0])
+    planner = Planner(problem.robot, problem.obstacles, problem.options)
+    q = np.asarray(problem.start, dtype=float)
+    for path in (q[None], np.vstack([q, q]), np.vstack([q, q + 0.01])):
+        np.testing.assert_array_equal(shortcut(planner.checker, path, seed=0), path)
