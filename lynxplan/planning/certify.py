@@ -36,8 +36,6 @@ import numba
 import numpy as np
 
 from lynxplan.planning.edge_walk import (
-    MAX_GROWTH,
-    STEP_GROWTH,
     copy_row,
     farthest_lane,
     lever_arms,
@@ -45,6 +43,7 @@ from lynxplan.planning.edge_walk import (
     pose_pair_at,
     reach_step,
     span_motion,
+    two_sided_step,
 )
 from lynxplan.planning.kernel_model import (
     LANES,
@@ -284,13 +283,9 @@ def _chain(
             motion[count - 1] = static * (1.0 - s)
             s, b = 1.0, ends[1]
             continue
-        # the walk's step (edge_walk): longer while the bound grows, down to one-sided steps
-        # as it closes in at the speed its one-sided step assumes
+        # the walk's step: longer while the bound grows, one-sided steps as it closes in
         one = reach_step(b, p, arms, 0, model, scratch)
-        speed = b / one
-        closing = speed - min(max(trend, -speed), speed)
-        step = STEP_GROWTH * b / closing if closing > 0.0 else MAX_GROWTH * one
-        t = min(1.0, s + min(step, MAX_GROWTH * one))
+        t = min(1.0, s + two_sided_step(b, one, trend))
         while True:  # halve the step until the two-sided test passes (one inlined bound)
             bt = _bound_at(q_a, q_b, t, p, model, scratch, 1)
             span = span_motion(p, t - s, model, scratch)

@@ -382,6 +382,19 @@ def _walk_start(
 
 
 @numba.njit(cache=True, inline="always")
+def two_sided_step(slack: float, one: float, trend: float) -> float:
+    """The length of s to try for a two-sided step from a point with ``slack`` [m] above the
+    clearance, one-sided step ``one`` and slack trend [m per unit s] (its change at the last
+    step): the bound's speed V ~ slack / one; the two ends' slacks sum to about 2 slack +
+    trend t, enough while t < 2 slack / (V - trend). Approaching (trend ~ -V): one-sided
+    steps; at most :data:`MAX_GROWTH` of them."""
+    speed = slack / one
+    closing = speed - min(max(trend, -speed), speed)
+    span = STEP_GROWTH * slack / closing if closing > 0.0 else MAX_GROWTH * one
+    return min(span, MAX_GROWTH * one)
+
+
+@numba.njit(cache=True, inline="always")
 def place_lanes(s: float, sigma: float, one: float, trend: float, out: np.ndarray) -> bool:
     """The points of a run (:func:`_lane_run`) from s, slack sigma [m], one-sided step ``one``
     and slack trend [m per unit s] -> out[OUT_S]; False when there is no step to take."""
@@ -594,13 +607,8 @@ def edge_walk(
             reach[p] = np.inf
             continue
         s = where[p]
-        # Two-sided step length from the slack's trend (its change per unit s at the last step):
-        # the bound's speed V ~ slack / ds; the two ends' slacks sum to about 2 slack + trend t,
-        # enough while t < 2 slack / (V - trend). Approaching (trend ~ -V): one-sided steps.
         one = nearest - s
-        speed = slack[p] / one
-        closing = speed - min(max(trend[p], -speed), speed)
-        span = STEP_GROWTH * slack[p] / closing if closing > 0.0 else MAX_GROWTH * one
+        span = two_sided_step(slack[p], one, trend[p])
         copy_row(arms, 0, all_arms, p)
         if lanes:
             run = _lane_run(q_a, q_b, p, nearest, model, scratch, clearance)
@@ -610,7 +618,7 @@ def edge_walk(
                 counters[3] = p
                 return -run
         if not lanes and span > 1.2 * one:  # (the lanes' first point was this one)
-            t = min(1.0, s + min(span, MAX_GROWTH * one))
+            t = min(1.0, s + span)
             if _two_sided_step(q_a, q_b, p, s, t, model, scratch, clearance):
                 continue
         slack_t = _pair_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
