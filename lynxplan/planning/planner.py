@@ -17,7 +17,7 @@ import numpy as np
 from lynxplan import _jit
 from lynxplan.collision import CollisionWorld, Obstacle
 from lynxplan.exceptions import InputError, PlanningFailed, StateInCollisionError
-from lynxplan.planning.certify import schedule
+from lynxplan.planning.certify import verification_rows
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
 from lynxplan.planning.shortcut import (
@@ -214,7 +214,9 @@ class Planner:
         and verification kernels before the clock starts, on a path that stays at q (nq,), a
         valid configuration: their run is trivial, their compile is not. (RRT-Connect compiles
         its own kernel outside its time limit.)"""
-        if cast(Any, shortcut_path).overloads and schedule.overloads:  # (.signatures: ~20 us each)
+        # (the entry points called from Python: a kernel loaded from numba's cache registers no
+        # overloads for its compiled callees; .signatures: ~20 us each)
+        if cast(Any, shortcut_path).overloads and cast(Any, verification_rows).overloads:
             return
         path = np.vstack([q, q])
         lower, upper = self.space.lower, self.space.upper

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -172,3 +175,31 @@ def test_a_huge_node_budget_reserves_no_memory_up_front() -> None:
         )
     assert done.returncode in (0, 1), done.stderr[-2000:]
     assert "solved False" in done.stdout, (done.stdout, done.stderr[-2000:])
+
+
+def test_a_process_that_loads_the_kernels_from_the_cache_compiles_nothing_per_solve(
+    planner: Planner,
+) -> None:
+    """The warm-up run of the shortcut and verification kernels (``Planner._compile``) runs
+    only before the first solve, also in a process that loads them from numba's cache (which
+    registers no overloads for compiled callees)."""
+    planner.solve(START, GOAL, seed=1)  # this process compiles and caches the kernels
+    script = f"""
+import numpy as np
+from lynxplan.arm import Arm
+from lynxplan.collision import BoxObstacle
+from lynxplan.planning import Planner
+planner = Planner(Arm(), [BoxObstacle("table", {TABLE.centre.tolist()}, {TABLE.size.tolist()}),
+                          BoxObstacle("wall", {WALL.centre.tolist()}, {WALL.size.tolist()})])
+start, goal = np.array({START.tolist()}), np.array({GOAL.tolist()})
+planner.solve(start, goal, seed=1)
+calls = []
+verify = planner.verifier.verify
+planner.verifier.verify = lambda *a, **k: calls.append(1) or verify(*a, **k)
+planner.solve(start, goal, seed=2)
+print(len(calls))
+"""
+    done = subprocess.run(
+        [sys.executable, "-c", script], capture_output=True, text=True, timeout=300, check=True
+    )
+    assert done.stdout.split()[-1] == "1"  # the solve's own verification only
