@@ -24,6 +24,7 @@ import numpy as np
 
 from lynxplan.exceptions import InputError, RetimingError
 from lynxplan.trajectory.lspb import unit_lspb
+from lynxplan.trajectory.ruckig_samples import ruckig_states
 from lynxplan.trajectory.timing import auto_timing_linear
 
 METHODS = ("ruckig", "lspb", "toppra")
@@ -49,9 +50,14 @@ class TimedPath(NamedTuple):
     segment: np.ndarray
 
 
-def _unit_limit(limit: np.ndarray, delta: np.ndarray) -> float:
-    moving = np.abs(delta) > 0
-    return float(np.min(limit[moving] / np.abs(delta[moving])))
+def _unit_limits(limits: tuple[np.ndarray, ...], delta: np.ndarray) -> list[float]:
+    """The limits of the path parameter s (one per joint limit array (nq,)): the tightest
+    ``limit_j / |delta_j|`` over the joints that move."""
+    steps = [abs(x) for x in delta.tolist()]
+    return [
+        min(bound / step for bound, step in zip(limit.tolist(), steps, strict=True) if step > 0)
+        for limit in limits
+    ]
 
 
 def _ruckig_law(
@@ -63,9 +69,8 @@ def _ruckig_law(
     params.current_position, params.target_position = [0.0], [1.0]
     params.current_velocity = params.current_acceleration = [0.0]
     params.target_velocity = params.target_acceleration = [0.0]
-    params.max_velocity = [_unit_limit(velocity, delta)]
-    params.max_acceleration = [_unit_limit(acceleration, delta)]
-    params.max_jerk = [_unit_limit(jerk, delta)]
+    v, a, j = _unit_limits((velocity, acceleration, jerk), delta)
+    params.max_velocity, params.max_acceleration, params.max_jerk = [v], [a], [j]
     trajectory = Trajectory(1)
     try:
         result = Ruckig(1).calculate(params, trajectory)
@@ -74,8 +79,8 @@ def _ruckig_law(
     if result not in (Result.Working, Result.Finished):
         raise RetimingError("ruckig", str(result))
     t = _times(float(trajectory.duration), rate)
-    states = np.array([trajectory.at_time(float(x)) for x in t])[:, :, 0]  # (N, 3)
-    return t, states[:, 0], states[:, 1], states[:, 2]
+    s, sd, sdd = ruckig_states(trajectory, t)
+    return t, s[:, 0], sd[:, 0], sdd[:, 0]
 
 
 def _lspb_law(
@@ -116,8 +121,12 @@ def _toppra_law(
 
 
 def _times(duration: float, rate: float) -> np.ndarray:
+    """Samples 0..duration, at least ``rate`` [Hz] apart, the ends included: np.linspace's values
+    (its step times the index, the last exactly ``duration``), without its overhead."""
     count = max(2, math.ceil(duration * rate - 1e-9) + 1)
-    return np.linspace(0.0, duration, count)
+    t = np.arange(count) * (duration / (count - 1))
+    t[-1] = duration
+    return t
 
 
 def time_parameterize(

@@ -34,6 +34,7 @@ from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.line import LineSegment
 from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import DEFAULT_SAMPLE_RATE, Plan
+from lynxplan.trajectory.ruckig_samples import ruckig_states
 from lynxplan.trajectory.timing import auto_timing_linear, auto_timing_path
 
 METHODS = ("lspb", "lspb_auto", "ruckig", "ruckig_lspb_duration", "toppra")
@@ -160,8 +161,8 @@ def ruckig_profile(
     if result not in (Result.Working, Result.Finished):
         raise RetimingError("ruckig", str(result))
     t = sample_times(trajectory.duration, rate)
-    states = np.array([trajectory.at_time(float(x)) for x in t])  # (N, 3, 5)
-    return Profile(t, states[:, 0], states[:, 1], states[:, 2], requested_duration=minimum_duration)
+    position, velocity, acceleration = ruckig_states(trajectory, t)
+    return Profile(t, position, velocity, acceleration, requested_duration=minimum_duration)
 
 
 def toppra_profile(
