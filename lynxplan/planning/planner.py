@@ -16,7 +16,7 @@ import numpy as np
 
 from lynxplan import _jit
 from lynxplan.collision import CollisionWorld, Obstacle
-from lynxplan.exceptions import InputError, PlanningFailed, StateInCollisionError
+from lynxplan.exceptions import InputError, PlanningFailed
 from lynxplan.planning.certify import verification_rows
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
@@ -28,7 +28,12 @@ from lynxplan.planning.shortcut import (
 from lynxplan.planning.space import JointSpace
 from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE, METHODS, TimedPath, time_parameterize
 from lynxplan.planning.validity import STALL_DISTANCE, ValidityChecker
-from lynxplan.planning.verify import VerificationReport, require_clear, verifier_of
+from lynxplan.planning.verify import (
+    VerificationReport,
+    clear_states,
+    require_clear,
+    verifier_of,
+)
 from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION, DEFAULT_MAX_JERK
 
 _jit.listen()  # the planner's kernels: a notice when their first compile takes long
@@ -235,19 +240,13 @@ class Planner:
         q_start = self.space.check(start, "start", tolerance=1e-9)
         goals = goal_configurations(self.robot, self.space, goal)
         self._check_state(q_start, "start")
-        free, first_error = [], None
-        for k, q_goal in enumerate(goals.configurations):
-            try:
-                self._check_state(
-                    q_goal,
-                    "goal" if len(goals.configurations) == 1 else f"goal ({goals.labels[k]})",
-                )
-                free.append(k)
-            except StateInCollisionError as exc:
-                first_error = first_error or exc
+        names = (
+            ["goal"] if len(goals.configurations) == 1 else [f"goal ({x})" for x in goals.labels]
+        )
+        problems = clear_states(self.world, goals.configurations, names, self.options.clearance)
+        free = [k for k, problem in enumerate(problems) if problem is None]
         if not free:
-            assert first_error is not None
-            raise first_error
+            raise next(p for p in problems if p is not None)
         self._require_certifiable(q_start, "start")
         certifiable = [k for k in free if self.checker.is_valid(goals.configurations[k])]
         if not certifiable:

@@ -29,6 +29,7 @@ itself, densely.
 from __future__ import annotations
 
 import weakref
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -433,12 +434,29 @@ def closest_contact(world: CollisionWorld, q: np.ndarray) -> tuple[float, str, s
     return float(distances[0]), link, obstacle
 
 
-def require_clear(world: CollisionWorld, q: np.ndarray, what: str, clearance: float) -> float:
-    """The exact clearance at q; raises StateInCollisionError below ``clearance`` [m]."""
-    distance, link, obstacle = closest_contact(world, q)
-    if distance < clearance:
-        raise StateInCollisionError(what, link, obstacle, -distance, clearance)
-    return distance
+def require_clear(world: CollisionWorld, q: np.ndarray, what: str, clearance: float) -> None:
+    """Raises StateInCollisionError where the exact clearance at q (nq,) is below
+    ``clearance`` [m]."""
+    problem = clear_states(world, np.reshape(q, (1, -1)), (what,), clearance)[0]
+    if problem is not None:
+        raise problem
+
+
+def clear_states(
+    world: CollisionWorld, q: np.ndarray, what: Sequence[str], clearance: float
+) -> list[StateInCollisionError | None]:
+    """For each configuration of q (N, nq): None when its exact clearance reaches ``clearance``
+    [m], else the StateInCollisionError naming ``what[n]``, the link, the obstacle and the depth
+    (the configurations' bounds in one compiled call: :meth:`ExactVerifier.closest`)."""
+    distances, pairs = verifier_of(world).closest(np.asarray(q, dtype=float))
+    problems: list[StateInCollisionError | None] = []
+    for distance, pair, name in zip(distances.tolist(), pairs.tolist(), what, strict=True):
+        if distance >= clearance:
+            problems.append(None)
+            continue
+        link, _geometry, obstacle = world.pair_names(pair) if pair >= 0 else ("", "", "")
+        problems.append(StateInCollisionError(name, link, obstacle, -distance, clearance))
+    return problems
 
 
 def sample_clearances(world: CollisionWorld, q: np.ndarray) -> np.ndarray:

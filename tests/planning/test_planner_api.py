@@ -19,6 +19,7 @@ from lynxplan.exceptions import (
     StateInCollisionError,
 )
 from lynxplan.planning import ApproachGoal, Planner, PlannerOptions, PoseGoal
+from lynxplan.planning.problem import goal_configurations
 
 TABLE = BoxObstacle("table", [0.0, 0.1, -0.105], [0.9, 0.7, 0.03])
 WALL = BoxObstacle("wall", [0.0, 0.285, 0.18], [0.02, 0.33, 0.54])
@@ -66,6 +67,18 @@ def test_start_in_collision_names_link_obstacle_and_depth(planner: Planner) -> N
     assert error.value.penetration_depth > 0.005
     with pytest.raises(StateInCollisionError, match="goal is in collision"):
         planner.solve(START, inside)
+
+
+def test_a_goal_set_in_collision_names_its_first_goal(planner: Planner) -> None:
+    """Every IK branch and roll of an approach goal inside the wall collides: the error names the
+    first goal configuration (its branch and roll), the link, the wall and the depth."""
+    goal = ApproachGoal([0.0, 0.2, 0.05], [0.0, 0.0, -1.0])
+    goals = goal_configurations(planner.robot, planner.space, goal)
+    assert len(goals.configurations) > 1
+    with pytest.raises(StateInCollisionError, match=r"with wall, penetration depth") as error:
+        planner.solve(START, goal)
+    assert error.value.what == f"goal ({goals.labels[0]})"
+    assert error.value.penetration_depth > 0.0
 
 
 def test_start_outside_the_limits_is_an_input_error(planner: Planner) -> None:
