@@ -157,19 +157,12 @@ def time_parameterize(
     if not math.isfinite(rate) or rate <= 0:
         raise InputError(f"sample rate must be positive. Got: {rate!r} Hz")
     path = np.asarray(waypoints, dtype=float)
-    nq = path.shape[1]
-    times, qs, qds, qdds, segments = (
-        [np.zeros(1)],
-        [path[:1]],
-        [np.zeros((1, nq))],
-        [np.zeros((1, nq))],
-        [np.zeros(1, dtype=np.int64)],
-    )
+    deltas = path[1:] - path[:-1]  # (N - 1, nq)
+    moving = np.abs(deltas).max(axis=1, initial=0.0) > 0
+    times, s_parts, sd_parts, sdd_parts, segments, counts = [np.zeros(1)], [], [], [], [], []
     offset = 0.0
-    for k in range(len(path) - 1):
-        delta = path[k + 1] - path[k]
-        if not np.any(np.abs(delta) > 0):
-            continue
+    for k in np.flatnonzero(moving).tolist():
+        delta = deltas[k]
         if method == "ruckig":
             t, s, sd, sdd = _ruckig_law(delta, velocity, acceleration, jerk, rate)
         elif method == "lspb":
@@ -179,15 +172,21 @@ def time_parameterize(
         s = s[1:]
         s[-1] = 1.0  # the segment ends exactly on the waypoint
         times.append(offset + t[1:])
-        qs.append(path[k] + s[:, None] * delta)
-        qds.append(sd[1:, None] * delta)
-        qdds.append(sdd[1:, None] * delta)
-        segments.append(np.full(len(s), k, dtype=np.int64))
+        s_parts.append(s)
+        sd_parts.append(sd[1:])
+        sdd_parts.append(sdd[1:])
+        segments.append(k)
+        counts.append(len(s))
         offset += float(t[-1])
+    # every sample at once: its segment's start plus s, s' and s'' times the segment
+    segment = np.repeat(np.asarray(segments, dtype=np.int64), counts)
+    step = deltas[segment]
+    rest = np.zeros((1, path.shape[1]))
+    q, qd, qdd = path[:1].copy(), rest, rest.copy()
+    if len(segment):
+        q = np.concatenate([q, path[segment] + np.concatenate(s_parts)[:, None] * step])
+        qd = np.concatenate([qd, np.concatenate(sd_parts)[:, None] * step])
+        qdd = np.concatenate([qdd, np.concatenate(sdd_parts)[:, None] * step])
     return TimedPath(
-        np.concatenate(times),
-        np.concatenate(qs),
-        np.concatenate(qds),
-        np.concatenate(qdds),
-        np.concatenate(segments),
+        np.concatenate(times), q, qd, qdd, np.concatenate([np.zeros(1, dtype=np.int64), segment])
     )
