@@ -18,6 +18,7 @@ Example (``scenarios/planning/`` holds the problem suite)::
       goal_bias: 0.05
       max_nodes: 20000                          # per tree
       shortcut_iterations: 60
+      shortcut_patience: 7                      # random cuts stop after 7 that changed nothing
       timing: ruckig                            # ruckig | lspb | toppra
       sample_rate: 100                          # [Hz]
       acceleration: 458                         # angle unit / s^2, scalar or per joint
@@ -92,6 +93,12 @@ class PlannerEntry(StrictModel):
     )
     max_nodes: int = Field(20000, ge=2, le=10_000_000, description="Node budget per tree.")
     shortcut_iterations: int = Field(60, ge=0, le=100_000)
+    shortcut_patience: int = Field(
+        7,
+        ge=1,
+        le=100_000,
+        description="Random shortcuts stop after this many attempts in a row that changed nothing.",
+    )
     timing: Literal["ruckig", "lspb", "toppra"] = "ruckig"
     sample_rate: Positive = Field(100.0, le=1e5, description="Samples per second, in [Hz].")
     acceleration: PerJoint | None = Field(None, description="Angle unit/s^2 (default 8 rad/s^2).")
@@ -184,6 +191,7 @@ def planner_options(scenario: Input) -> Any:
     values: dict[str, Any] = {
         "max_nodes": entry.max_nodes,
         "shortcut_iterations": entry.shortcut_iterations,
+        "shortcut_patience": entry.shortcut_patience,
         "timing": entry.timing,
         "sample_rate": entry.sample_rate,
     }

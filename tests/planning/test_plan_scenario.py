@@ -67,3 +67,12 @@ def test_start_in_collision_is_an_error_naming_the_obstacle(tmp_path: Path) -> N
 def test_goal_needs_exactly_one_form() -> None:
     with pytest.raises(Exception, match="give exactly one of q, pose, position"):
         load_scenario(_scenario(goal={"q": [0, 0, 0, 0, 0], "position": [0, 0, 0]}))
+
+
+def test_planner_block_sets_the_shortcut_patience() -> None:
+    from lynxplan.scenarios.plan import planner_options
+
+    scenario = load_scenario(_scenario(planner={"seed": 1, "shortcut_patience": 3}))
+    assert planner_options(scenario.scenario).shortcut_patience == 3
+    with pytest.raises(ScenarioError, match="shortcut_patience"):
+        load_scenario(_scenario(planner={"shortcut_patience": 0}))

@@ -131,6 +131,21 @@ def test_bad_options_are_input_errors() -> None:
         PlannerOptions(timing="spline")
     with pytest.raises(InputError, match="step"):
         PlannerOptions(step=0.0)
+    with pytest.raises(InputError, match="shortcut_patience = 0"):
+        PlannerOptions(shortcut_patience=0)
+
+
+def test_shortcut_patience_trades_path_length_for_time(arm: Arm, planner: Planner) -> None:
+    """The random cuts are the same draws whatever the patience, so stopping after the first
+    attempt that changes nothing keeps a prefix of the default's cuts: never shorter paths."""
+    hasty = Planner(arm, [TABLE, WALL], PlannerOptions(shortcut_patience=1))
+    lengths = [
+        (hasty.solve(START, GOAL, seed=seed).path_length, planner.solve(START, GOAL, seed=seed))
+        for seed in range(8)
+    ]
+    assert all(short >= full.path_length - 1e-9 for short, full in lengths)
+    assert any(short > full.path_length + 1e-6 for short, full in lengths)
+    assert all(full.verification.collision_free for _, full in lengths)
 
 
 def test_a_start_the_checker_cannot_certify_fails_at_once(arm: Arm) -> None:
