@@ -193,30 +193,29 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
     from lynxplan.arm.model import Arm
 
     approach_only = isinstance(goal, ApproachGoal)
-    if isinstance(goal, PoseGoal) or not isinstance(robot, Arm):
-        # A URDF robot's IK leaves the roll free for an approach goal: every root, exactly.
-        poses = goal.pose[None] if isinstance(goal, PoseGoal) else goal.pose_at(0.0)[None]
-        references: list[np.ndarray | None] = [None]
-    else:
-        # The roll about the approach axis is the last joint's (yaw-pitch^3-roll family): one
-        # IK per sampled last-joint angle.
+    pose = goal.pose if isinstance(goal, PoseGoal) else goal.pose_at(0.0)
+    rolls: np.ndarray | None = None
+    reference = None
+    if isinstance(goal, ApproachGoal) and isinstance(robot, Arm):
+        # The AL5's approach axis is its roll axis, with the tool point on it: the roll moves
+        # neither, so each sampled roll of the last joint has the same branches in the other
+        # joints (the IK sets q5 to the reference's). One IK, the roll set to each sample.
+        # (A URDF robot's IK leaves the roll free for an approach goal: every root, exactly.)
         rolls = np.linspace(space.lower[-1], space.upper[-1], goal.roll_samples)
-        poses = np.repeat(goal.pose_at(0.0)[None], len(rolls), axis=0)
-        rows = np.zeros((len(rolls), space.dimension))  # (zeros, roll) each
-        rows[:, -1] = rolls
-        references = list(rows)
+        reference = np.zeros(space.dimension)
+        reference[-1] = rolls[0]
+    try:
+        solutions = _exact_solutions(robot, pose, approach_only, reference)
+    except KinematicsError as exc:
+        raise GoalUnreachableError(str(exc)) from None
     found: list[np.ndarray] = []
     labels: list[str] = []
-    reasons: list[str] = []
     nq = space.dimension
-    for pose, reference in zip(poses, references, strict=True):
-        try:
-            solutions = _exact_solutions(robot, pose, approach_only, reference)
-        except KinematicsError as exc:
-            reasons.append(str(exc))
-            continue
+    for roll in [None] if rolls is None else rolls.tolist():
         for solution in solutions:
-            q = np.asarray(solution.q, dtype=float)
+            q = np.array(solution.q, dtype=float)
+            if roll is not None:
+                q[-1] = roll
             if not solution.within_limits or not np.isfinite(q).all():
                 continue
             if found and (np.abs(np.reshape(found, (-1, nq)) - q).max(axis=1) <= 1e-9).any():
@@ -225,5 +224,5 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
             suffix = f" roll {np.degrees(q[-1]):.0f} deg" if approach_only else ""
             labels.append(f"{solution.branch}{suffix}")
     if not found:
-        raise GoalUnreachableError(reasons[0] if reasons else "no IK branch within the limits")
+        raise GoalUnreachableError("no IK branch within the limits")
     return GoalSet(np.array(found), tuple(labels))

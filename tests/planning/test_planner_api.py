@@ -231,3 +231,27 @@ print(len(calls))
         [sys.executable, "-c", script], capture_output=True, text=True, timeout=300, check=True
     )
     assert done.stdout.split()[-1] == "1"  # the solve's own verification only
+
+
+def test_approach_goal_rolls_match_one_ik_per_roll(arm: Arm, planner: Planner) -> None:
+    """The AL5's approach goal solves its IK once and sets each sampled roll: the same goal
+    configurations, bit for bit, as one IK per sampled roll with that roll as the reference."""
+    space = planner.space
+    rng = np.random.default_rng(3)
+    checked = 0
+    for _ in range(60):
+        tool = arm.fk(rng.uniform(space.lower, space.upper))
+        goal = ApproachGoal(tool[:3, 3], tool[:3, 2])
+        expected = []
+        for roll in np.linspace(space.lower[-1], space.upper[-1], goal.roll_samples):
+            reference = np.r_[np.zeros(4), roll]
+            result = arm.ik(goal.pose_at(0.0), approach_only=True, q_reference=reference)
+            for solution in result.solutions:
+                q = np.asarray(solution.q)
+                new = all(np.abs(q - x).max() > 1e-9 for x in expected)
+                if solution.within_limits and np.isfinite(q).all() and new:
+                    expected.append(np.clip(q, space.lower, space.upper))
+        goals = goal_configurations(arm, space, goal)
+        assert np.array_equal(goals.configurations, np.array(expected))
+        checked += 1
+    assert checked == 60
