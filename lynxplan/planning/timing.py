@@ -121,8 +121,9 @@ def _toppra_law(
 
 
 def _times(duration: float, rate: float) -> np.ndarray:
-    """Samples 0..duration, at least ``rate`` [Hz] apart, the ends included: np.linspace's values
-    (its step times the index, the last exactly ``duration``), without its overhead."""
+    """Equally spaced sample times from 0 to ``duration`` [s], both included, at least ``rate``
+    [Hz]: np.linspace's values (its step times the index, the last exactly ``duration``),
+    without its overhead."""
     count = max(2, math.ceil(duration * rate - 1e-9) + 1)
     t = np.arange(count) * (duration / (count - 1))
     t[-1] = duration
