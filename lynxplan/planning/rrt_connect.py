@@ -489,6 +489,14 @@ class _Trees(NamedTuple):
         return bigger
 
 
+def _room(capacity: int, used: int, per_call: int, limit: int) -> int:
+    """Rows each tree needs before a kernel call that may add ``per_call`` nodes to a tree of
+    ``used``: ``capacity`` while it suffices, else doubled (at least enough), at most ``limit``."""
+    if capacity < limit and used + per_call >= capacity:
+        return min(limit, max(2 * capacity, used + per_call + 1))
+    return capacity
+
+
 def rrt_connect(
     checker: ValidityChecker,
     lower: np.ndarray,
@@ -514,9 +522,7 @@ def rrt_connect(
     per_call = CHUNK_ITERATIONS * (
         2 + math.ceil(float(np.linalg.norm(upper - lower)) / settings.step)
     )
-    capacity = min(limit, INITIAL_CAPACITY)
-    if capacity < limit and len(goals) + per_call >= capacity:
-        capacity = min(limit, max(2 * capacity, len(goals) + per_call + 1))
+    capacity = _room(min(limit, INITIAL_CAPACITY), len(goals), per_call, limit)
     state = _rng.seed_state(seed)
     model, scratch, clearance = checker.model, checker.scratch, checker.clearance
     fixed = (lower, upper, settings.step, settings.goal_bias, model, scratch, clearance)
@@ -550,9 +556,9 @@ def rrt_connect(
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
-        capacity = trees.nodes.shape[1]
-        if capacity < limit and int(counts.max()) + per_call >= capacity:
-            trees = trees.grown(min(limit, max(2 * capacity, int(counts.max()) + per_call + 1)))
+        capacity = _room(trees.nodes.shape[1], int(counts.max()), per_call, limit)
+        if capacity > trees.nodes.shape[1]:
+            trees = trees.grown(capacity)
         nodes, parents = trees.nodes, trees.parents
         status = rrt_connect_kernel(*arguments(trees))
     path, goal_index = _solution(nodes, parents, meta)
