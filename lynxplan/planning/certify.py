@@ -12,8 +12,9 @@ at any ``s`` in between every point is at least ``max(d0 - a, d1 - b)`` away wit
 This module only *chooses* the parameters ``s`` at which the verifier asks coal for exact
 distances; it proves nothing itself:
 
-- a pair whose bounding-sphere gaps prove it apart on the segment needs no exact query there
-  (a primitive lies inside its circumscribed sphere: a plain, independent lower bound): either
+- a pair whose covering-sphere gaps prove it apart on the segment needs no exact query there
+  (a primitive lies inside the union of its covering spheres, a few along its longest axis:
+  :class:`lynxplan.collision.primitives.LinkPrimitive`; a plain, independent lower bound): either
   the gaps at both ends satisfy the inequality with the static bound ``L``, or the gaps on a
   uniform grid of the segment (all pairs at once) or a short chain of sphere gaps do with the
   lever-arm motion bounds of :func:`lynxplan.planning.validity.span_motion` (tested against
@@ -57,7 +58,7 @@ from lynxplan.planning.lanes import (
     OUT_S,
     OUT_SPHERE,
     all_pair_bounds,
-    pair_along,
+    spheres_along,
 )
 from lynxplan.planning.validity import (
     centre_gap,
@@ -75,39 +76,59 @@ MIN_STEP = 1e-4
 SPHERE_STEPS = 48
 #: Intervals of the uniform grid of sphere gaps tried first, all pairs at once.
 SPHERE_GRID = 8
-#: ... tried only when the tight bounds at both ends exceed this, in [m] (closer pairs need the
-#: exact chain anyway: a sphere gap is below the tight bound).
-SPHERE_CHAIN_ABOVE = 0.01
+
+
+@numba.njit(cache=True, inline="always")
+def _cover_centre(poses: np.ndarray, g: int, c: np.ndarray) -> tuple[float, float, float]:
+    """World position of the point c (3,) of primitive g's frame (poses (G, 4, 4)), in [m]."""
+    return (
+        poses[g, 0, 3] + poses[g, 0, 0] * c[0] + poses[g, 0, 1] * c[1] + poses[g, 0, 2] * c[2],
+        poses[g, 1, 3] + poses[g, 1, 0] * c[0] + poses[g, 1, 1] * c[1] + poses[g, 1, 2] * c[2],
+        poses[g, 2, 3] + poses[g, 2, 0] * c[0] + poses[g, 2, 1] * c[1] + poses[g, 2, 2] * c[2],
+    )
 
 
 @numba.njit(cache=True, inline="always")
 def sphere_gap(p: int, model: Any, scratch: Any) -> float:
-    """Bounding-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
+    """Covering-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
 
-    Robot primitives by their circumscribed spheres; a box obstacle (a cylinder obstacle is
-    stored as its bounding box, which contains it) by its exact point distance, a sphere
-    obstacle exactly.
+    Robot primitives by their covering spheres (model[17..19]: a primitive lies inside the union
+    of its spheres); a box obstacle (a cylinder obstacle is stored as its bounding box, which
+    contains it) by the exact point distance of each sphere centre, a sphere obstacle exactly.
     """
-    prim_radius, pairs = model[7], model[8]
-    kinds, poses_b, obstacle_half = model[10], model[12], model[13]
+    pairs, kinds, poses_b, obstacle_half = model[8], model[10], model[12], model[13]
+    centres, counts, radii = model[17], model[18], model[19]
     poses = scratch[3]
     a, b = pairs[p, 0], pairs[p, 1]
+    best = np.inf  # the smallest squared distance of a centre of a
     if pairs[p, 2] == 1:
-        return centre_gap(poses, a, prim_radius[a], poses, b, prim_radius[b])
+        for i in range(counts[a]):
+            x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
+            for k in range(counts[b]):
+                y0, y1, y2 = _cover_centre(poses, b, centres[b, k])
+                best = min(best, (x0 - y0) ** 2 + (x1 - y1) ** 2 + (x2 - y2) ** 2)
+        self_gap: float = math.sqrt(best) - radii[a] - radii[b]
+        return self_gap
     if kinds[b] == OBSTACLE_SPHERE:
-        return centre_gap(poses, a, prim_radius[a], poses_b, b, obstacle_half[b, 0])
-    total = 0.0
-    dx = poses[a, 0, 3] - poses_b[b, 0, 3]
-    dy = poses[a, 1, 3] - poses_b[b, 1, 3]
-    dz = poses[a, 2, 3] - poses_b[b, 2, 3]
-    for k in range(3):
-        excess = (
-            abs(poses_b[b, 0, k] * dx + poses_b[b, 1, k] * dy + poses_b[b, 2, k] * dz)
-            - obstacle_half[b, k]
-        )
-        if excess > 0.0:
-            total += excess * excess
-    box_gap: float = math.sqrt(total) - prim_radius[a]
+        c0, c1, c2 = poses_b[b, 0, 3], poses_b[b, 1, 3], poses_b[b, 2, 3]
+        for i in range(counts[a]):
+            x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
+            best = min(best, (x0 - c0) ** 2 + (x1 - c1) ** 2 + (x2 - c2) ** 2)
+        ball_gap: float = math.sqrt(best) - radii[a] - obstacle_half[b, 0]
+        return ball_gap
+    for i in range(counts[a]):
+        x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
+        dx, dy, dz = x0 - poses_b[b, 0, 3], x1 - poses_b[b, 1, 3], x2 - poses_b[b, 2, 3]
+        total = 0.0
+        for k in range(3):
+            excess = (
+                abs(poses_b[b, 0, k] * dx + poses_b[b, 1, k] * dy + poses_b[b, 2, k] * dz)
+                - obstacle_half[b, k]
+            )
+            if excess > 0.0:
+                total += excess * excess
+        best = min(best, total)
+    box_gap: float = math.sqrt(best) - radii[a]
     return box_gap
 
 
@@ -161,7 +182,7 @@ def _sphere_chain(
 ) -> bool:
     """Whether pair p's sphere gaps alone prove it apart on the whole segment: a chain of
     points, from at most :data:`SPHERE_STEPS` evaluated (LANES at a time, by
-    :func:`lynxplan.planning.lanes.pair_along`), whose consecutive gaps exceed the motion bound
+    :func:`lynxplan.planning.lanes.spheres_along`), whose consecutive gaps exceed the motion bound
     between them (:func:`lynxplan.planning.validity.span_motion`) or that lie within the
     previous point's one-sided reach (:func:`lynxplan.planning.edge_walk.reach_step`)."""
     arms = scratch[13]
@@ -180,7 +201,7 @@ def _sphere_chain(
     for _ in range(SPHERE_STEPS // LANES):
         if s + one >= 1.0 or not place_lanes(s, gap, one, trend, out):
             break
-        pair_along(q_a, q_b, p, model, out)
+        spheres_along(q_a, q_b, p, model, out)
         progressed, i = False, 0
         while i < LANES and s + one < 1.0:
             best = farthest_lane(i, s, gap, one, p, model, scratch, OUT_SPHERE, 0.0, 0.0)
@@ -244,7 +265,7 @@ def _sphere_grid(
 def _grid_clear(gaps: np.ndarray, p: int) -> bool:
     """Whether pair p's sphere gaps on the grid of :func:`_sphere_grid` (gaps (n + 1, P), in
     [m]) are all positive. A sphere chain cannot prove a pair apart on a segment where its
-    bounding sphere touches the obstacle at a grid point (the chain's interval over that point
+    covering spheres touch the obstacle at a grid point (the chain's interval over that point
     would prove the sphere apart there): such a pair goes to the exact chain at once."""
     smallest: float = gaps[:, p].min()
     return smallest > 0.0
@@ -378,8 +399,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any, waypoints: A
                 at_waypoint[p] = count
                 count += 1
             elif not todo[p] or (
-                min(start[1, p], end[1, p]) > SPHERE_CHAIN_ABOVE
-                and _grid_clear(gaps, p)
+                _grid_clear(gaps, p)
                 and _sphere_chain(path[k], path[k + 1], p, start[0, p], model, scratch)
             ):
                 at_waypoint[p] = -1

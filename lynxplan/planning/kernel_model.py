@@ -116,7 +116,9 @@ def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, 
     radii, 8 pairs, 9 pair motion rates (P, nq) [m/rad], 10 obstacle kinds, 11 obstacle centres,
     12 obstacle poses, 13 obstacle half sizes, 14 obstacle bounding radii, 15 pair joint owners
     (P, nq): the primitive of the pair that joint j moves relative to the other side (-1: none),
-    16 the joint (frame) index of each configuration index (nq,).
+    16 the joint (frame) index of each configuration index (nq,), 17 primitive covering sphere
+    centres (G, K, 3) in the primitive frame, 18 their counts (G,), 19 their radii (G,)
+    (:func:`_cover_arrays`).
     """
     axes, index_q, parents, placements, prim_joints, prim_placements = world._kernel_joints
     half = np.array([_box_half_extents(p.kind, p.half_extents) for p in world.links])
@@ -139,8 +141,25 @@ def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, 
         obstacle_radius,
         pair_owners(world, pairs),
         _joint_of_coordinate(world),
+        *_cover_arrays(world),
     )
     return tuple(np.ascontiguousarray(a) for a in arrays)
+
+
+def _cover_arrays(world: CollisionWorld) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Each primitive's covering spheres (:class:`lynxplan.collision.primitives.LinkPrimitive`):
+    centres in the primitive frame (G, K, 3) (K: the most of any primitive; unused rows 0), in
+    [m], counts (G,), radii (G,), in [m]."""
+    links = world.links
+    most = max((len(link.sphere_centres) for link in links), default=1)
+    centres = np.zeros((len(links), most, 3))
+    counts = np.zeros(len(links), dtype=np.int64)
+    radii = np.zeros(len(links))
+    for g, link in enumerate(links):
+        count = len(link.sphere_centres)
+        centres[g, :count] = link.sphere_centres
+        counts[g], radii[g] = count, link.sphere_radius
+    return centres, counts, radii
 
 
 def world_pairs(world: CollisionWorld) -> np.ndarray:

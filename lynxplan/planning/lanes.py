@@ -60,9 +60,9 @@ _BOUND = _T + 1
 _ROWS = _BOUND + 1
 #: The work rows of :func:`pair_along`, on its stack.
 _lane_rows = stack_array(_ROWS, LANES)
-#: Rows of the output of :func:`pair_along`: 0 the bound [m], 1 the parameter s (input), 2 the
-#: bounding-sphere gap of the exact verification [m], 3 + j the lever arm about configuration
-#: index j [m].
+#: Rows of the output of :func:`pair_along` and :func:`spheres_along`: 0 the bound [m], 1 the
+#: parameter s (input), 2 the covering-sphere gap of the exact verification [m], 3 + j the lever
+#: arm about configuration index j [m].
 OUT_BOUND, OUT_S, OUT_SPHERE, OUT_ARMS = 0, 1, 2, 3
 
 
@@ -297,17 +297,13 @@ def _arm_rows(w: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
             out[OUT_ARMS + j, i] = w[_T, i]
 
 
-@njit_no_refcount(error_model="numpy", fastmath=_FAST)
-def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
-    """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
-    [rad]: out[OUT_BOUND] its distance lower bound [m], out[OUT_ARMS + j] its lever arm about
-    configuration index j [m], out[OUT_SPHERE] its bounding-sphere gap [m]; out: (3 + nq,
-    LANES).
-
-    The model must satisfy :func:`lanes_supported`.
-    """
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _pose_pair_rows(
+    q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray, w: np.ndarray
+) -> None:
+    """Pair p's robot primitives posed at the LANES points s_i = out[OUT_S, i] of the edge from
+    q_a to q_b (nq,): rows _A (and _B for a self pair)."""
     pairs, prim_joints = model[8], model[4]
-    w = _lane_rows()
     for i in range(LANES):
         w[_S, i] = out[OUT_S, i]
     for r in range(12):  # the universe frame: identity
@@ -321,9 +317,23 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
     for j in range(1, last + 1):
         _joint_rows(w, j, model, q_a, q_b)
     _primitive_rows(w, _A, a, model)
-    half, radius = model[6], model[7]
     if is_self == 1:
         _primitive_rows(w, _B, b, model)
+
+
+@njit_no_refcount(error_model="numpy", fastmath=_FAST)
+def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
+    """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
+    [rad]: out[OUT_BOUND] its distance lower bound [m], out[OUT_ARMS + j] its lever arm about
+    configuration index j [m]; out: (3 + nq, LANES).
+
+    The model must satisfy :func:`lanes_supported`.
+    """
+    w = _lane_rows()
+    _pose_pair_rows(q_a, q_b, p, model, out, w)
+    a, b, is_self = model[8][p, 0], model[8][p, 1], model[8][p, 2]
+    half, radius = model[6], model[7]
+    if is_self == 1:
         _box_bounds(w, half, a, half, b, radius[a] + radius[b])
     elif model[10][b] == OBSTACLE_SPHERE:
         _sphere_bounds(w, half, a, model, b)
@@ -332,6 +342,20 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
         _box_bounds(w, half, a, model[13], b, radius[a] + model[14][b])
     for i in range(LANES):
         out[OUT_BOUND, i] = w[_BOUND, i]
+    _arm_rows(w, p, model, out)
+
+
+@njit_no_refcount(error_model="numpy", fastmath=_FAST)
+def spheres_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
+    """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
+    [rad]: out[OUT_SPHERE] its covering-sphere gap (the exact verification's independent bound,
+    :func:`lynxplan.planning.certify.sphere_gap`) [m], out[OUT_ARMS + j] its lever arm about
+    configuration index j [m]; out: (3 + nq, LANES).
+
+    The model must satisfy :func:`lanes_supported`.
+    """
+    w = _lane_rows()
+    _pose_pair_rows(q_a, q_b, p, model, out, w)
     _sphere_gap_rows(w, p, model)
     for i in range(LANES):
         out[OUT_SPHERE, i] = w[_BOUND, i]
@@ -339,27 +363,47 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
-def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
-    """The bounding-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`: robot
-    primitives by their circumscribed spheres, a box obstacle by its exact point distance, a
-    sphere obstacle exactly) from rows _A (and _B), every lane -> row _BOUND, in [m]."""
-    pairs, radius = model[8], model[7]
-    a, b = pairs[p, 0], pairs[p, 1]
-    ra = radius[a]
-    if pairs[p, 2] == 1:
-        rb = radius[b]
+def _cover_rows(w: np.ndarray, rows: int, c: np.ndarray, out: int) -> None:
+    """World position of the point c (3,) of the primitive posed in rows ``rows``, every lane ->
+    rows out..out+2."""
+    for r in range(3):
+        m0, m1, m2, t = rows + 3 * r, rows + 3 * r + 1, rows + 3 * r + 2, rows + 9 + r
         for i in range(LANES):
-            d0 = w[_B + 9, i] - w[_A + 9, i]
-            d1 = w[_B + 10, i] - w[_A + 10, i]
-            d2 = w[_B + 11, i] - w[_A + 11, i]
-            w[_BOUND, i] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2) - ra - rb
+            w[out + r, i] = w[t, i] + w[m0, i] * c[0] + w[m1, i] * c[1] + w[m2, i] * c[2]
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
+    """The covering-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`: robot
+    primitives by their covering spheres, a box obstacle by the exact point distance of each
+    centre, a sphere obstacle exactly) from rows _A (and _B), every lane -> row _BOUND, in [m].
+    Rows _P.._P+5 (the joint axis rows, free once the primitives are posed) hold centres."""
+    pairs, centres, counts, radii = model[8], model[17], model[18], model[19]
+    a, b = pairs[p, 0], pairs[p, 1]
+    for i in range(LANES):
+        w[_BOUND, i] = np.inf  # the smallest squared distance of a centre of a
+    if pairs[p, 2] == 1:
+        for m in range(counts[a]):
+            _cover_rows(w, _A, centres[a, m], _P)
+            for k in range(counts[b]):
+                _cover_rows(w, _B, centres[b, k], _P + 3)
+                for i in range(LANES):
+                    d0 = w[_P + 3, i] - w[_P, i]
+                    d1 = w[_P + 4, i] - w[_P + 1, i]
+                    d2 = w[_P + 5, i] - w[_P + 2, i]
+                    w[_BOUND, i] = min(w[_BOUND, i], d0 * d0 + d1 * d1 + d2 * d2)
+        for i in range(LANES):
+            w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a] - radii[b]
         return
     if model[10][b] == OBSTACLE_SPHERE:  # (rows _B are not filled for a sphere obstacle)
         c0, c1, c2 = model[12][b, 0, 3], model[12][b, 1, 3], model[12][b, 2, 3]
-        rb = model[13][b, 0]
+        for m in range(counts[a]):
+            _cover_rows(w, _A, centres[a, m], _P)
+            for i in range(LANES):
+                d0, d1, d2 = c0 - w[_P, i], c1 - w[_P + 1, i], c2 - w[_P + 2, i]
+                w[_BOUND, i] = min(w[_BOUND, i], d0 * d0 + d1 * d1 + d2 * d2)
         for i in range(LANES):
-            d0, d1, d2 = c0 - w[_A + 9, i], c1 - w[_A + 10, i], c2 - w[_A + 11, i]
-            w[_BOUND, i] = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2) - ra - rb
+            w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a] - model[13][b, 0]
         return
     pose, half = model[12], model[13]
     c0, c1, c2 = pose[b, 0, 3], pose[b, 1, 3], pose[b, 2, 3]
@@ -367,12 +411,16 @@ def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
     x0, x1, x2 = pose[b, 0, 0], pose[b, 1, 0], pose[b, 2, 0]
     y0, y1, y2 = pose[b, 0, 1], pose[b, 1, 1], pose[b, 2, 1]
     z0, z1, z2 = pose[b, 0, 2], pose[b, 1, 2], pose[b, 2, 2]
+    for m in range(counts[a]):
+        _cover_rows(w, _A, centres[a, m], _P)
+        for i in range(LANES):
+            d0, d1, d2 = w[_P, i] - c0, w[_P + 1, i] - c1, w[_P + 2, i] - c2
+            e0 = max(abs(x0 * d0 + x1 * d1 + x2 * d2) - h0, 0.0)
+            e1 = max(abs(y0 * d0 + y1 * d1 + y2 * d2) - h1, 0.0)
+            e2 = max(abs(z0 * d0 + z1 * d1 + z2 * d2) - h2, 0.0)
+            w[_BOUND, i] = min(w[_BOUND, i], e0 * e0 + e1 * e1 + e2 * e2)
     for i in range(LANES):
-        d0, d1, d2 = w[_A + 9, i] - c0, w[_A + 10, i] - c1, w[_A + 11, i] - c2
-        e0 = max(abs(x0 * d0 + x1 * d1 + x2 * d2) - h0, 0.0)
-        e1 = max(abs(y0 * d0 + y1 * d1 + y2 * d2) - h1, 0.0)
-        e2 = max(abs(z0 * d0 + z1 * d1 + z2 * d2) - h2, 0.0)
-        w[_BOUND, i] = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2) - ra
+        w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a]
 
 
 #: Pairs per block of :func:`all_pair_bounds` (a constant width: no run-time aliasing checks).

@@ -17,6 +17,7 @@ from lynxplan.planning.lanes import (
     OUT_SPHERE,
     all_pair_bounds,
     pair_along,
+    spheres_along,
 )
 from lynxplan.planning.validity import ValidityChecker, pair_bound, primitive_poses
 from lynxplan.planning.verify import ExactVerifier
@@ -61,7 +62,7 @@ def test_all_pair_bounds_match_the_scalar_bounds_and_stay_below_coal(
     assert near > 5  # close pairs were compared, not only far ones
 
 
-def test_pair_along_matches_single_steps_and_stays_below_coal(
+def test_pair_and_spheres_along_match_single_steps_and_stay_below_coal(
     arm: Arm, world: CollisionWorld
 ) -> None:
     from lynxplan.planning.edge_walk import pose_pair_at
@@ -81,6 +82,9 @@ def test_pair_along_matches_single_steps_and_stays_below_coal(
         p = k % pairs
         out[OUT_S] = np.sort(rng.uniform(0.0, 1.0, LANES))
         pair_along(q_a, q_b, p, model, out)
+        bounds_arms = out[OUT_ARMS:].copy()
+        spheres_along(q_a, q_b, p, model, out)
+        np.testing.assert_array_equal(out[OUT_ARMS:], bounds_arms)
         for i in range(LANES):
             s = out[OUT_S, i]
             pose_pair_at(q_a, q_b, s, p, model, scratch, 1)
