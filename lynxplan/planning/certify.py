@@ -61,7 +61,6 @@ from lynxplan.planning.lanes import (
     spheres_along,
 )
 from lynxplan.planning.validity import (
-    centre_gap,
     joint_poses,
     joint_poses_upto,
     pair_bound,

@@ -387,40 +387,51 @@ def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
             _cover_rows(w, _A, centres[a, m], _P)
             for k in range(counts[b]):
                 _cover_rows(w, _B, centres[b, k], _P + 3)
-                for i in range(LANES):
-                    d0 = w[_P + 3, i] - w[_P, i]
-                    d1 = w[_P + 4, i] - w[_P + 1, i]
-                    d2 = w[_P + 5, i] - w[_P + 2, i]
-                    w[_BOUND, i] = min(w[_BOUND, i], d0 * d0 + d1 * d1 + d2 * d2)
-        for i in range(LANES):
-            w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a] - radii[b]
-        return
-    if model[10][b] == OBSTACLE_SPHERE:  # (rows _B are not filled for a sphere obstacle)
-        c0, c1, c2 = model[12][b, 0, 3], model[12][b, 1, 3], model[12][b, 2, 3]
+                _nearest_point(w)
+        other = radii[b]
+    elif model[10][b] == OBSTACLE_SPHERE:  # (rows _B are not filled for a sphere obstacle)
+        for r in range(3):
+            for i in range(LANES):
+                w[_P + 3 + r, i] = model[12][b, r, 3]
         for m in range(counts[a]):
             _cover_rows(w, _A, centres[a, m], _P)
-            for i in range(LANES):
-                d0, d1, d2 = c0 - w[_P, i], c1 - w[_P + 1, i], c2 - w[_P + 2, i]
-                w[_BOUND, i] = min(w[_BOUND, i], d0 * d0 + d1 * d1 + d2 * d2)
-        for i in range(LANES):
-            w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a] - model[13][b, 0]
-        return
-    pose, half = model[12], model[13]
-    c0, c1, c2 = pose[b, 0, 3], pose[b, 1, 3], pose[b, 2, 3]
-    h0, h1, h2 = half[b, 0], half[b, 1], half[b, 2]
-    x0, x1, x2 = pose[b, 0, 0], pose[b, 1, 0], pose[b, 2, 0]
-    y0, y1, y2 = pose[b, 0, 1], pose[b, 1, 1], pose[b, 2, 1]
-    z0, z1, z2 = pose[b, 0, 2], pose[b, 1, 2], pose[b, 2, 2]
-    for m in range(counts[a]):
-        _cover_rows(w, _A, centres[a, m], _P)
-        for i in range(LANES):
-            d0, d1, d2 = w[_P, i] - c0, w[_P + 1, i] - c1, w[_P + 2, i] - c2
-            e0 = max(abs(x0 * d0 + x1 * d1 + x2 * d2) - h0, 0.0)
-            e1 = max(abs(y0 * d0 + y1 * d1 + y2 * d2) - h1, 0.0)
-            e2 = max(abs(z0 * d0 + z1 * d1 + z2 * d2) - h2, 0.0)
-            w[_BOUND, i] = min(w[_BOUND, i], e0 * e0 + e1 * e1 + e2 * e2)
+            _nearest_point(w)
+        other = model[13][b, 0]
+    else:
+        for m in range(counts[a]):
+            _cover_rows(w, _A, centres[a, m], _P)
+            _nearest_box(w, model[12][b], model[13][b])
+        other = 0.0
     for i in range(LANES):
-        w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a]
+        w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a] - other
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _nearest_point(w: np.ndarray) -> None:
+    """Row _BOUND lowered to the squared distance of the points in rows _P.._P+2 and
+    _P+3.._P+5, every lane."""
+    for i in range(LANES):
+        d0 = w[_P + 3, i] - w[_P, i]
+        d1 = w[_P + 4, i] - w[_P + 1, i]
+        d2 = w[_P + 5, i] - w[_P + 2, i]
+        w[_BOUND, i] = min(w[_BOUND, i], d0 * d0 + d1 * d1 + d2 * d2)
+
+
+@numba.njit(cache=True, inline="always", fastmath=_FAST)
+def _nearest_box(w: np.ndarray, pose: np.ndarray, half: np.ndarray) -> None:
+    """Row _BOUND lowered to the squared distance of the point in rows _P.._P+2 from the box
+    of pose (4, 4) and half sizes (3,), every lane."""
+    c0, c1, c2 = pose[0, 3], pose[1, 3], pose[2, 3]
+    h0, h1, h2 = half[0], half[1], half[2]
+    x0, x1, x2 = pose[0, 0], pose[1, 0], pose[2, 0]
+    y0, y1, y2 = pose[0, 1], pose[1, 1], pose[2, 1]
+    z0, z1, z2 = pose[0, 2], pose[1, 2], pose[2, 2]
+    for i in range(LANES):
+        d0, d1, d2 = w[_P, i] - c0, w[_P + 1, i] - c1, w[_P + 2, i] - c2
+        e0 = max(abs(x0 * d0 + x1 * d1 + x2 * d2) - h0, 0.0)
+        e1 = max(abs(y0 * d0 + y1 * d1 + y2 * d2) - h1, 0.0)
+        e2 = max(abs(z0 * d0 + z1 * d1 + z2 * d2) - h2, 0.0)
+        w[_BOUND, i] = min(w[_BOUND, i], e0 * e0 + e1 * e1 + e2 * e2)
 
 
 #: Pairs per block of :func:`all_pair_bounds` (a constant width: no run-time aliasing checks).
