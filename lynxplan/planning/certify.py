@@ -88,47 +88,59 @@ def _cover_centre(poses: np.ndarray, g: int, c: np.ndarray) -> tuple[float, floa
 
 
 @numba.njit(cache=True, inline="always")
-def sphere_gap(p: int, model: Any, scratch: Any) -> float:
-    """Covering-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
-
-    Robot primitives by their covering spheres (model[17..19]: a primitive lies inside the union
-    of its spheres); a box obstacle (a cylinder obstacle is stored as its bounding box, which
-    contains it) by the exact point distance of each sphere centre, a sphere obstacle exactly.
-    """
-    pairs, kinds, poses_b, obstacle_half = model[8], model[10], model[12], model[13]
+def _spheres_to_box(
+    poses: np.ndarray, a: int, boxes: np.ndarray, b: int, half: np.ndarray, model: Any
+) -> float:
+    """Lower bound of the distance of robot primitive a (poses (G, 4, 4)) from the box b of
+    poses boxes (N, 4, 4) and half sizes half (N, 3): the exact point distance of each of a's
+    covering sphere centres from the box, less the spheres' radius, in [m]."""
     centres, counts, radii = model[17], model[18], model[19]
-    poses = scratch[3]
-    a, b = pairs[p, 0], pairs[p, 1]
-    best = np.inf  # the smallest squared distance of a centre of a
-    if pairs[p, 2] == 1:
-        for i in range(counts[a]):
-            x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
-            for k in range(counts[b]):
-                y0, y1, y2 = _cover_centre(poses, b, centres[b, k])
-                best = min(best, (x0 - y0) ** 2 + (x1 - y1) ** 2 + (x2 - y2) ** 2)
-        self_gap: float = math.sqrt(best) - radii[a] - radii[b]
-        return self_gap
-    if kinds[b] == OBSTACLE_SPHERE:
-        c0, c1, c2 = poses_b[b, 0, 3], poses_b[b, 1, 3], poses_b[b, 2, 3]
-        for i in range(counts[a]):
-            x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
-            best = min(best, (x0 - c0) ** 2 + (x1 - c1) ** 2 + (x2 - c2) ** 2)
-        ball_gap: float = math.sqrt(best) - radii[a] - obstacle_half[b, 0]
-        return ball_gap
+    best = np.inf  # the smallest squared distance of a centre
     for i in range(counts[a]):
         x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
-        dx, dy, dz = x0 - poses_b[b, 0, 3], x1 - poses_b[b, 1, 3], x2 - poses_b[b, 2, 3]
+        dx, dy, dz = x0 - boxes[b, 0, 3], x1 - boxes[b, 1, 3], x2 - boxes[b, 2, 3]
         total = 0.0
         for k in range(3):
             excess = (
-                abs(poses_b[b, 0, k] * dx + poses_b[b, 1, k] * dy + poses_b[b, 2, k] * dz)
-                - obstacle_half[b, k]
+                abs(boxes[b, 0, k] * dx + boxes[b, 1, k] * dy + boxes[b, 2, k] * dz) - half[b, k]
             )
             if excess > 0.0:
                 total += excess * excess
         best = min(best, total)
-    box_gap: float = math.sqrt(best) - radii[a]
-    return box_gap
+    gap: float = math.sqrt(best) - radii[a]
+    return gap
+
+
+@numba.njit(cache=True, inline="always")
+def sphere_gap(p: int, model: Any, scratch: Any) -> float:
+    """Covering-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
+
+    A robot primitive lies inside the union of its covering spheres (model[17..19]) and inside
+    its box (model[6]: a cylinder's or a mesh hull's bounding box): the bound is the exact
+    point distance of one primitive's sphere centres from the other's box, less the spheres'
+    radius (for a self pair the larger of the two ways round), from a box obstacle the same (a
+    cylinder obstacle is stored as its bounding box, which contains it), from a sphere obstacle
+    the centres' distance less both radii.
+    """
+    pairs, kinds, poses_b, obstacle_half = model[8], model[10], model[12], model[13]
+    poses = scratch[3]
+    a, b = pairs[p, 0], pairs[p, 1]
+    if pairs[p, 2] == 1:
+        half = model[6]
+        return max(
+            _spheres_to_box(poses, a, poses, b, half, model),
+            _spheres_to_box(poses, b, poses, a, half, model),
+        )
+    if kinds[b] != OBSTACLE_SPHERE:
+        return _spheres_to_box(poses, a, poses_b, b, obstacle_half, model)
+    centres, counts, radii = model[17], model[18], model[19]
+    c0, c1, c2 = poses_b[b, 0, 3], poses_b[b, 1, 3], poses_b[b, 2, 3]
+    best = np.inf
+    for i in range(counts[a]):
+        x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
+        best = min(best, (x0 - c0) ** 2 + (x1 - c1) ** 2 + (x2 - c2) ** 2)
+    ball_gap: float = math.sqrt(best) - radii[a] - obstacle_half[b, 0]
+    return ball_gap
 
 
 @numba.njit(cache=True, inline="always")

@@ -374,36 +374,41 @@ def _cover_rows(w: np.ndarray, rows: int, c: np.ndarray, out: int) -> None:
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
 def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
-    """The covering-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`: robot
-    primitives by their covering spheres, a box obstacle by the exact point distance of each
-    centre, a sphere obstacle exactly) from rows _A (and _B), every lane -> row _BOUND, in [m].
-    Rows _P.._P+5 (the joint axis rows, free once the primitives are posed) hold centres."""
-    pairs, centres, counts, radii = model[8], model[17], model[18], model[19]
+    """The covering-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`) from
+    rows _A (and _B), every lane -> row _BOUND, in [m]. Rows _P.._P+5 (the joint axis rows, free
+    once the primitives are posed) hold sphere centres, row _T the other way round's distance."""
+    pairs, centres, counts, radii, half = model[8], model[17], model[18], model[19], model[6]
     a, b = pairs[p, 0], pairs[p, 1]
     for i in range(LANES):
         w[_BOUND, i] = np.inf  # the smallest squared distance of a centre of a
+        w[_T, i] = np.inf  # ... of a centre of b (a self pair)
     if pairs[p, 2] == 1:
         for m in range(counts[a]):
             _cover_rows(w, _A, centres[a, m], _P)
-            for k in range(counts[b]):
-                _cover_rows(w, _B, centres[b, k], _P + 3)
-                _nearest_point(w)
-        other = radii[b]
-    elif model[10][b] == OBSTACLE_SPHERE:  # (rows _B are not filled for a sphere obstacle)
+            _nearest_box(w, _B, half[b], _BOUND)
+        for m in range(counts[b]):
+            _cover_rows(w, _B, centres[b, m], _P)
+            _nearest_box(w, _A, half[a], _T)
+        ra, rb = radii[a], radii[b]
+        for i in range(LANES):
+            w[_BOUND, i] = max(math.sqrt(w[_BOUND, i]) - ra, math.sqrt(w[_T, i]) - rb)
+        return
+    if model[10][b] == OBSTACLE_SPHERE:  # the centres' distance less both radii
         for r in range(3):
             for i in range(LANES):
                 w[_P + 3 + r, i] = model[12][b, r, 3]
         for m in range(counts[a]):
             _cover_rows(w, _A, centres[a, m], _P)
             _nearest_point(w)
-        other = model[13][b, 0]
+        other = radii[a] + model[13][b, 0]
     else:
+        _fixed_rows(w, _B, model[12], b)
         for m in range(counts[a]):
             _cover_rows(w, _A, centres[a, m], _P)
-            _nearest_box(w, model[12][b], model[13][b])
-        other = 0.0
+            _nearest_box(w, _B, model[13][b], _BOUND)
+        other = radii[a]
     for i in range(LANES):
-        w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - radii[a] - other
+        w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - other
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
@@ -418,20 +423,21 @@ def _nearest_point(w: np.ndarray) -> None:
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
-def _nearest_box(w: np.ndarray, pose: np.ndarray, half: np.ndarray) -> None:
-    """Row _BOUND lowered to the squared distance of the point in rows _P.._P+2 from the box
-    of pose (4, 4) and half sizes (3,), every lane."""
-    c0, c1, c2 = pose[0, 3], pose[1, 3], pose[2, 3]
+def _nearest_box(w: np.ndarray, rows: int, half: np.ndarray, out: int) -> None:
+    """Row ``out`` lowered to the squared distance of the point in rows _P.._P+2 from the box
+    posed in rows ``rows`` with half sizes half (3,), every lane."""
     h0, h1, h2 = half[0], half[1], half[2]
-    x0, x1, x2 = pose[0, 0], pose[1, 0], pose[2, 0]
-    y0, y1, y2 = pose[0, 1], pose[1, 1], pose[2, 1]
-    z0, z1, z2 = pose[0, 2], pose[1, 2], pose[2, 2]
     for i in range(LANES):
-        d0, d1, d2 = w[_P, i] - c0, w[_P + 1, i] - c1, w[_P + 2, i] - c2
-        e0 = max(abs(x0 * d0 + x1 * d1 + x2 * d2) - h0, 0.0)
-        e1 = max(abs(y0 * d0 + y1 * d1 + y2 * d2) - h1, 0.0)
-        e2 = max(abs(z0 * d0 + z1 * d1 + z2 * d2) - h2, 0.0)
-        w[_BOUND, i] = min(w[_BOUND, i], e0 * e0 + e1 * e1 + e2 * e2)
+        d0 = w[_P, i] - w[rows + 9, i]
+        d1 = w[_P + 1, i] - w[rows + 10, i]
+        d2 = w[_P + 2, i] - w[rows + 11, i]
+        x = w[rows, i] * d0 + w[rows + 3, i] * d1 + w[rows + 6, i] * d2
+        y = w[rows + 1, i] * d0 + w[rows + 4, i] * d1 + w[rows + 7, i] * d2
+        z = w[rows + 2, i] * d0 + w[rows + 5, i] * d1 + w[rows + 8, i] * d2
+        e0 = max(abs(x) - h0, 0.0)
+        e1 = max(abs(y) - h1, 0.0)
+        e2 = max(abs(z) - h2, 0.0)
+        w[out, i] = min(w[out, i], e0 * e0 + e1 * e1 + e2 * e2)
 
 
 #: Pairs per block of :func:`all_pair_bounds` (a constant width: no run-time aliasing checks).
