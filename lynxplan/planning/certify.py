@@ -12,9 +12,9 @@ at any ``s`` in between every point is at least ``max(d0 - a, d1 - b)`` away wit
 This module only *chooses* the parameters ``s`` at which the verifier asks coal for exact
 distances; it proves nothing itself:
 
-- a pair whose covering-sphere gaps prove it apart on the segment needs no exact query there
-  (a primitive lies inside the union of its covering spheres, a few along its longest axis:
-  :class:`lynxplan.collision.primitives.LinkPrimitive`; a plain, independent lower bound): either
+- a pair whose sphere gaps prove it apart on the segment needs no exact query there (the
+  point distance of one primitive's covering spheres, a few along its longest axis, from the
+  other's box, less their radius: :func:`sphere_gap`, a plain, independent lower bound): either
   the gaps at both ends satisfy the inequality with the static bound ``L``, or the gaps on a
   uniform grid of the segment (all pairs at once) or a short chain of sphere gaps do with the
   lever-arm motion bounds of :func:`lynxplan.planning.validity.span_motion` (tested against

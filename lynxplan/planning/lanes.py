@@ -4,10 +4,11 @@
 straight joint edge ``q(s) = q_a + s (q_b - q_a)``, the same quantities as one step of the
 scalar edge walk (:func:`lynxplan.planning.edge_walk.pose_pair_at` and
 :func:`lynxplan.planning.validity.pair_bound`): the pair's lower bound of the distance and its
-lever arms about each joint. The lanes are the innermost loop of every computation, stored as
-rows of a constant-width scratch array (structure of arrays, one row a quantity), with selects
-instead of branches, so LLVM turns each loop into SIMD instructions (several configurations
-for about the price of one).
+lever arms about each joint; :func:`spheres_along` the exact verification's sphere gap
+(:func:`lynxplan.planning.certify.sphere_gap`) with the same lever arms. The lanes are the
+innermost loop of every computation, stored as rows of a constant-width scratch array
+(structure of arrays, one row a quantity), with selects instead of branches, so LLVM turns each
+loop into SIMD instructions (several configurations for about the price of one).
 
 The bound is the same kind as the scalar one, computed over every axis: the larger of the
 bounding-sphere gap and the separating-axis gap over all 15 axes of the separating axis theorem
@@ -58,7 +59,7 @@ _S = _B + 12
 _T = _S + 1
 _BOUND = _T + 1
 _ROWS = _BOUND + 1
-#: The work rows of :func:`pair_along`, on its stack.
+#: The work rows of :func:`pair_along` and :func:`spheres_along`, on their stack.
 _lane_rows = stack_array(_ROWS, LANES)
 #: Rows of the output of :func:`pair_along` and :func:`spheres_along`: 0 the bound [m], 1 the
 #: parameter s (input), 2 the covering-sphere gap of the exact verification [m], 3 + j the lever

@@ -7,9 +7,9 @@ conservative advancement on each straight joint segment, pair by pair: a pair is
 ``[s0, s1]`` when lower bounds ``d0``, ``d1`` of its distance at both ends exceed, together, the
 bound ``L (s1 - s0)`` on the motion of any of its points in between (``L``:
 :func:`lynxplan.planning.kernel_model.pair_rates`; proof in :mod:`lynxplan.collision.check`).
-The lower bounds are exact coal distances, except for a pair whose covering-sphere gaps (a
-primitive inside the union of a few spheres along its longest axis) already prove the whole
-segment. Where to query is
+The lower bounds are exact coal distances, except for a pair whose sphere gaps (one
+primitive's covering spheres against the other's box: :func:`lynxplan.planning.certify.sphere_gap`)
+already prove the whole segment. Where to query is
 chosen by :mod:`lynxplan.planning.certify` from the planner's tight bounds, so a clear path
 needs few exact queries (one per pair and waypoint near an obstacle, plus about ``L / 2d``
 along a segment that stays ``d`` from it); an interval that the exact distances do not prove
