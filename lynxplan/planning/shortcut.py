@@ -20,13 +20,15 @@ Five passes over a piecewise-linear joint path, all with the planner's validity 
 4. *Random shortcuts* between two random points of the path by arc length (anywhere on its
    segments, not only at waypoints): a *full* cut, the straight edge between the points, or
    (a fraction ``partial`` of the attempts, none by default) a partial cut of one joint drawn in
-   proportion to its excess motion (total variation beyond its net displacement). The cuts
-   stop after ``patience`` attempts in a row that changed nothing.
+   proportion to its excess motion (total variation beyond its net displacement). A full cut
+   that would gain less than :data:`FULL_MIN_GAIN` of the path's length is not certified and
+   changes nothing. The cuts stop after ``patience`` attempts in a row that changed nothing.
 5. *Vertex shortcuts* again (as 1.): the cuts leave corners on the old path's segments, and
    most of them see past their neighbours.
 
-A cut is kept when it shortens the path (a random partial cut by at least :data:`MIN_GAIN`)
-and every new edge is certified. The parts of the old path kept around a cut are pieces of
+A cut is kept when it shortens the path (a random full cut by at least :data:`FULL_MIN_GAIN`
+of its length, a random partial cut by at least :data:`MIN_GAIN`) and every new edge is
+certified. The parts of the old path kept around a cut are pieces of
 certified edges: the path stays valid after every change ("verify after every shortcut" —
 pyroboplan's ``shortcut_path`` does not, and returns paths through obstacles).
 
@@ -65,7 +67,14 @@ from lynxplan.planning.validity import (
 #: Shortcut attempts by default.
 DEFAULT_SHORTCUT_ITERATIONS = 60
 #: Random cuts stop after this many attempts in a row that changed nothing.
-DEFAULT_SHORTCUT_PATIENCE = 7
+DEFAULT_SHORTCUT_PATIENCE = 16
+#: A random full cut must shorten the path by at least this fraction of its length; a cut that
+#: would gain less is not certified (without this, a quarter to a third of the certified cuts
+#: gained < 0.1 %, each at the cost of an edge walk of every pair). With the patience raised from
+#: 7 to 16 (a skipped cut counts as an attempt that changed nothing), paths come out shorter in
+#: less time: AL5 suite, 60 seeds, total of the median lengths 30.41 -> 29.10 rad, median
+#: planning ~7 % less (three alternating runs).
+FULL_MIN_GAIN = 0.01
 #: Fraction of the random attempts that are partial (one-joint) shortcuts. None by default:
 #: after the one-joint straightening, full cuts with a little more patience give paths as short
 #: (AL5 suite, 20 seeds: total of the median lengths 31.22 rad against 31.16 with half of the
@@ -243,14 +252,15 @@ def _full(
     clearance: float,
     work: np.ndarray,
     piece: np.ndarray,
+    gain: float,
 ) -> int:
     """Full shortcut: the straight edge between the points at arc lengths u1 < u2 replaces the
-    path between them when it is certified (in place); returns the new count, or 0 when
-    nothing changed."""
+    path between them when it shortens the path by at least ``gain`` [rad] and is certified (in
+    place); returns the new count, or 0 when nothing changed."""
     first, second = piece[0], piece[1]
     i1 = _point_at(path, cumulative, count, u1, first)
     i2 = _point_at(path, cumulative, count, u2, second)
-    if i1 == i2 or count + 2 > path.shape[0]:
+    if i1 == i2 or count + 2 > path.shape[0] or _distance(first, second) > (u2 - u1) - gain:
         return 0
     if not probes_are_clear(first, second, model, scratch, clearance) or (
         not edge_is_free_after_probes(first, second, model, scratch, clearance)
@@ -514,7 +524,8 @@ def shortcut_kernel(
             if size > 0:
                 count, idle = size, 0
             continue
-        size = _full(path, count, cumulative, u1, u2, model, scratch, clearance, work, piece)
+        gain = FULL_MIN_GAIN * total
+        size = _full(path, count, cumulative, u1, u2, model, scratch, clearance, work, piece, gain)
         if size > 0:
             count, idle = size, 0
     return _greedy(path, count, model, scratch, clearance)
