@@ -18,7 +18,7 @@ Example (``scenarios/planning/`` holds the problem suite)::
       goal_bias: 0.05
       max_nodes: 20000                          # per tree
       shortcut_iterations: 60
-      shortcut_patience: 16                     # random cuts stop after 16 that changed nothing
+      shortcut_patience: 12                     # random cuts stop after 12 that changed nothing
       timing: ruckig                            # ruckig | lspb | toppra
       sample_rate: 100                          # [Hz]
       acceleration: 458                         # angle unit / s^2, scalar or per joint
@@ -94,7 +94,7 @@ class PlannerEntry(StrictModel):
     max_nodes: int = Field(20000, ge=2, le=10_000_000, description="Node budget per tree.")
     shortcut_iterations: int = Field(60, ge=0, le=100_000)
     shortcut_patience: int = Field(
-        16,
+        12,
         ge=1,
         le=100_000,
         description="Random shortcuts stop after this many attempts in a row that changed nothing.",
