@@ -44,7 +44,7 @@ import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from lynxplan import _fastmath
-from lynxplan._fastmath import wide_vectors
+from lynxplan._fastmath import prefetch, prefetch_write, wide_vectors
 from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
@@ -826,6 +826,63 @@ def _repolish(
         c[_C_TAKE, k], c[_C_FALL, k] = 1.0, 0.0
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def _prefetch_block(
+    start: int,
+    nb: int,
+    targets: np.ndarray,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+) -> None:
+    """The cache lines of the block of poses from ``start`` on prefetched: its targets (to
+    read) and its slots in the flat outputs (to write), while the block before is computed
+    (the loads of the targets and the first stores to the slots otherwise wait on memory)."""
+    m = min(BLOCK, targets.shape[0] - start)
+    if m <= 0:
+        return
+    for k in range(0, 16 * m, 8):  # 16 doubles a pose, 8 a cache line
+        prefetch(targets, 16 * start + k)
+    first, last = start * nb, (start + m) * nb
+    for k in range(5 * first, 5 * last, 8):
+        prefetch_write(q, k)
+    for k in range(first, last, 64):
+        prefetch_write(valid, k)
+        prefetch_write(within, k)
+    for k in range(first, last, 8):
+        prefetch_write(position_error, k)
+        prefetch_write(orientation_error, k)
+
+
+@numba.njit(cache=True, nogil=True)
+def _clear_slots(
+    first: int,
+    last: int,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+) -> None:
+    """Slots first..last - 1 of the flat outputs (q: 5 values a slot) empty: NaN / False (one
+    contiguous run each, in whole vectors: unsigned indices, which numba does not wrap around,
+    so LLVM sees consecutive addresses rather than scattering the stores)."""
+    wide_vectors()
+    begin, end = np.uint64(first), np.uint64(last)
+    for k in range(np.uint64(5) * begin, np.uint64(5) * end):
+        q[k] = np.nan
+    for k in range(begin, end):
+        valid[k] = False
+    for k in range(begin, end):
+        within[k] = False
+    for k in range(begin, end):
+        position_error[k] = np.nan
+    for k in range(begin, end):
+        orientation_error[k] = np.nan
+
+
 @numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
     """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
@@ -918,11 +975,15 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     qs, jac, origins = np.empty(5), np.empty((6, 5)), np.empty((5, 6))
     normal, vectors = np.empty((7, 5)), np.empty((3, 6))
     taken = np.empty((4, 5))
+    # the outputs flat: every slot of a block is emptied by contiguous loops (vector stores)
+    q_flat, valid_flat, within_flat = q_out.reshape(-1), valid.reshape(-1), within.reshape(-1)
+    p_flat, o_flat = position_error.reshape(-1), orientation_error.reshape(-1)
     fallbacks = 0
     deferred = np.empty(64, dtype=np.int64)  # the poses left to the scalar solver (grows)
     deferred_count = 0
     for start in range(0, targets.shape[0], BLOCK):
         m = min(BLOCK, targets.shape[0] - start)
+        _prefetch_block(start + BLOCK, nb, targets, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             for r in range(3):
                 for col in range(4):
@@ -998,15 +1059,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 c[_C_FALL, i] = c[_C_FALL, BLOCK + i] = 0.0
         if not exact:
             _repolish(mc, pr, ch, c_flat, c2_flat, slot_index)
+        _clear_slots(start * nb, (start + m) * nb, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             n = start + i
-            for b in range(nb):  # every slot empty, then the branches written
-                for j in range(5):
-                    q_out[n, b, j] = np.nan
-                valid[n, b] = False
-                within[n, b] = False
-                position_error[n, b] = np.nan
-                orientation_error[n, b] = np.nan
             if s[_POSE_FALL, i] != 0.0:  # solved after the blocks (below)
                 if deferred_count == deferred.shape[0]:
                     grown = np.empty(2 * deferred.shape[0], dtype=np.int64)
