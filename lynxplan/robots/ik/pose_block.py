@@ -826,36 +826,6 @@ def _repolish(
         c[_C_TAKE, k], c[_C_FALL, k] = 1.0, 0.0
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def _prefetch_block(
-    start: int,
-    nb: int,
-    targets: np.ndarray,
-    q: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    position_error: np.ndarray,
-    orientation_error: np.ndarray,
-) -> None:
-    """The cache lines of the block of poses from ``start`` on prefetched: its targets (to
-    read) and its slots in the flat outputs (to write), while the block before is computed
-    (the loads of the targets and the first stores to the slots otherwise wait on memory)."""
-    m = min(BLOCK, targets.shape[0] - start)
-    if m <= 0:
-        return
-    for k in range(0, 16 * m, 8):  # 16 doubles a pose, 8 a cache line
-        prefetch(targets, 16 * start + k)
-    first, last = start * nb, (start + m) * nb
-    for k in range(5 * first, 5 * last, 8):
-        prefetch_write(q, k)
-    for k in range(first, last, 64):
-        prefetch_write(valid, k)
-        prefetch_write(within, k)
-    for k in range(first, last, 8):
-        prefetch_write(position_error, k)
-        prefetch_write(orientation_error, k)
-
-
 @numba.njit(cache=True, nogil=True)
 def _clear_slots(
     first: int,
@@ -983,7 +953,6 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     deferred_count = 0
     for start in range(0, targets.shape[0], BLOCK):
         m = min(BLOCK, targets.shape[0] - start)
-        _prefetch_block(start + BLOCK, nb, targets, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             for r in range(3):
                 for col in range(4):
@@ -1062,6 +1031,19 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         _clear_slots(start * nb, (start + m) * nb, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             n = start + i
+            # the next block's pose, prefetched (written out: an array passed to a function
+            # costs two atomic reference counts a call): its target and its slots
+            ahead = n + BLOCK
+            if ahead < targets.shape[0]:
+                prefetch(targets, 16 * ahead)  # 16 doubles a pose, 8 a cache line
+                prefetch(targets, 16 * ahead + 8)
+                for k in range(5 * nb * ahead, 5 * nb * (ahead + 1), 8):
+                    prefetch_write(q_flat, k)
+                if ahead % 8 == 0:
+                    prefetch_write(valid_flat, nb * ahead)
+                    prefetch_write(within_flat, nb * ahead)
+                prefetch_write(p_flat, nb * ahead)
+                prefetch_write(o_flat, nb * ahead)
             if s[_POSE_FALL, i] != 0.0:  # solved after the blocks (below)
                 if deferred_count == deferred.shape[0]:
                     grown = np.empty(2 * deferred.shape[0], dtype=np.int64)
