@@ -1059,7 +1059,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     gap = 0.0
                     for j in range(5):
                         gap = max(gap, abs(c[_C_Q + j, ka] - c[_C_Q + j, kb]))
-                    for h in range(2 if gap >= DUPLICATE_TOLERANCE else 1):  # kb: a duplicate?
+                    pair = gap >= DUPLICATE_TOLERANCE  # else kb is a duplicate
+                    for h in range(2 if pair else 1):
                         k = kb if h else ka
                         b = slot_of[k]
                         for j in range(5):
@@ -1069,6 +1070,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                         position_error[n, b] = c[_C_PERR, k]
                         orientation_error[n, b] = c[_C_OERR, k]
                     solved[n] = True
+                    # the smallest error over the slots (``smallest_error``: the others empty)
+                    nearest = c[_C_PERR, ka]
+                    distance[n] = min(nearest, c[_C_PERR, kb]) if pair else nearest
                     continue
             count = np.int64(0)  # not a literal 0: one compile of is_duplicate
             scalar = False
@@ -1110,9 +1114,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 position_error[n, b] = err
                 orientation_error[n, b] = angle
             solved[n] = count > 0
+            distance[n] = smallest_error(position_error, n)
             fallbacks += 1 if scalar else 0
-        for i in range(m):  # the block's errors, just written: in cache
-            distance[start + i] = smallest_error(position_error, start + i)
     # the poses for the scalar solver, one after the other: its code and branch history stay
     # warm (between two blocks' vector loops each one cost ~2.5 times as much)
     for d in range(deferred_count):
