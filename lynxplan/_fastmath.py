@@ -15,6 +15,8 @@ from typing import Any, cast
 
 import numba
 import numba.extending
+from llvmlite import ir
+from numba.core import cgutils
 
 # Cody-Waite split of pi/4 (Cephes DP1..DP3) and the sin/cos minimax polynomials on [0, pi/4].
 _DP1 = 7.85398125648498535156e-1
@@ -119,3 +121,36 @@ def _wide_vectors(typingctx: object) -> tuple[object, object]:
 
 #: Typed for callers: the intrinsic takes no argument in a kernel (numba passes ``typingctx``).
 wide_vectors = cast("Callable[[], None]", _wide_vectors)
+
+
+def _prefetcher(write: int) -> Any:
+    """An intrinsic ``(array, index)``: LLVM's prefetch of the cache line of element ``index``
+    of a C-contiguous array (its flat index; no bounds check: a prefetch never faults), for a
+    read (write 0) or a write (1). No other effect: the kernels start the memory traffic of
+    the next block of poses while they compute one."""
+
+    @numba.extending.intrinsic
+    def _prefetch(typingctx: object, array: Any, index: Any) -> tuple[object, object]:
+        def codegen(context: Any, builder: Any, signature: Any, args: Any) -> Any:
+            data = context.make_array(signature.args[0])(context, builder, args[0]).data
+            byte = ir.IntType(8).as_pointer()
+            address = builder.bitcast(builder.gep(data, [args[1]]), byte)
+            word = ir.IntType(32)
+            function = cgutils.get_or_insert_function(  # type: ignore[no-untyped-call]
+                builder.module,
+                ir.FunctionType(ir.VoidType(), [byte, word, word, word]),
+                "llvm.prefetch.p0",
+            )
+            # (address, write, locality 3: keep in every cache level, data cache)
+            builder.call(function, [address, word(write), word(3), word(1)])
+            return context.get_dummy_value()
+
+        return numba.types.none(array, numba.types.intp), codegen
+
+    return _prefetch
+
+
+#: Typed for callers: ``prefetch(array, index)`` before reading, ``prefetch_write`` before
+#: writing (the line is fetched for ownership).
+prefetch = cast("Callable[[Any, int], None]", _prefetcher(0))
+prefetch_write = cast("Callable[[Any, int], None]", _prefetcher(1))

@@ -8,7 +8,7 @@ import numba
 import numpy as np
 import pytest
 
-from lynxplan._fastmath import atan2, sincos, wide_vectors
+from lynxplan._fastmath import atan2, prefetch, prefetch_write, sincos, wide_vectors
 
 ULP_TOLERANCE = 4.5e-16  # a few units in the last place for values of order 1
 
@@ -88,3 +88,22 @@ def test_wide_vectors_reaches_the_compiled_function() -> None:
     (plain_ir,) = plain.inspect_llvm().values()
     assert '"prefer-vector-width"="512"' in wide_ir
     assert '"prefer-vector-width"="512"' not in plain_ir
+
+
+def test_prefetch_is_emitted_and_changes_nothing() -> None:
+    """The prefetches reach LLVM (a read and a write prefetch) and leave the arrays as they
+    were, also for an index past the end (a prefetch never faults)."""
+
+    @numba.njit
+    def touched(x: np.ndarray, y: np.ndarray) -> float:
+        for k in range(0, x.size + 64, 8):
+            prefetch(x, k)
+            prefetch_write(y, k)
+        return float(x.sum())
+
+    x, y = np.arange(16.0).reshape(4, 4), np.zeros(16)
+    assert touched(x, y) == 120.0
+    assert np.array_equal(x, np.arange(16.0).reshape(4, 4)) and not y.any()
+    (ir,) = touched.inspect_llvm().values()
+    assert "@llvm.prefetch" in ir
+    assert "i32 0, i32 3, i32 1" in ir and "i32 1, i32 3, i32 1" in ir

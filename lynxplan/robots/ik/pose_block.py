@@ -44,7 +44,7 @@ import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
 
 from lynxplan import _fastmath
-from lynxplan._fastmath import wide_vectors
+from lynxplan._fastmath import prefetch, prefetch_write, wide_vectors
 from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
@@ -827,6 +827,33 @@ def _repolish(
 
 
 @numba.njit(cache=True, nogil=True)
+def _clear_slots(
+    first: int,
+    last: int,
+    q: np.ndarray,
+    valid: np.ndarray,
+    within: np.ndarray,
+    position_error: np.ndarray,
+    orientation_error: np.ndarray,
+) -> None:
+    """Slots first..last - 1 of the flat outputs (q: 5 values a slot) empty: NaN / False (one
+    contiguous run each, in whole vectors: unsigned indices, which numba does not wrap around,
+    so LLVM sees consecutive addresses rather than scattering the stores)."""
+    wide_vectors()
+    begin, end = np.uint64(first), np.uint64(last)
+    for k in range(np.uint64(5) * begin, np.uint64(5) * end):
+        q[k] = np.nan
+    for k in range(begin, end):
+        valid[k] = False
+    for k in range(begin, end):
+        within[k] = False
+    for k in range(begin, end):
+        position_error[k] = np.nan
+    for k in range(begin, end):
+        orientation_error[k] = np.nan
+
+
+@numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
     """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
     of M'_1 .. M'_5, M'_tool (row-major; placements (6, 4, 4), axes (5, 3)).
@@ -918,6 +945,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     qs, jac, origins = np.empty(5), np.empty((6, 5)), np.empty((5, 6))
     normal, vectors = np.empty((7, 5)), np.empty((3, 6))
     taken = np.empty((4, 5))
+    # the outputs flat: every slot of a block is emptied by contiguous loops (vector stores)
+    q_flat, valid_flat, within_flat = q_out.reshape(-1), valid.reshape(-1), within.reshape(-1)
+    p_flat, o_flat = position_error.reshape(-1), orientation_error.reshape(-1)
     fallbacks = 0
     deferred = np.empty(64, dtype=np.int64)  # the poses left to the scalar solver (grows)
     deferred_count = 0
@@ -998,15 +1028,22 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 c[_C_FALL, i] = c[_C_FALL, BLOCK + i] = 0.0
         if not exact:
             _repolish(mc, pr, ch, c_flat, c2_flat, slot_index)
+        _clear_slots(start * nb, (start + m) * nb, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             n = start + i
-            for b in range(nb):  # every slot empty, then the branches written
-                for j in range(5):
-                    q_out[n, b, j] = np.nan
-                valid[n, b] = False
-                within[n, b] = False
-                position_error[n, b] = np.nan
-                orientation_error[n, b] = np.nan
+            # the next block's pose, prefetched (written out: an array passed to a function
+            # costs two atomic reference counts a call): its target and its slots
+            ahead = n + BLOCK
+            if ahead < targets.shape[0]:
+                prefetch(targets, 16 * ahead)  # 16 doubles a pose, 8 a cache line
+                prefetch(targets, 16 * ahead + 8)
+                for k in range(5 * nb * ahead, 5 * nb * (ahead + 1), 8):
+                    prefetch_write(q_flat, k)
+                if ahead % 8 == 0:
+                    prefetch_write(valid_flat, nb * ahead)
+                    prefetch_write(within_flat, nb * ahead)
+                prefetch_write(p_flat, nb * ahead)
+                prefetch_write(o_flat, nb * ahead)
             if s[_POSE_FALL, i] != 0.0:  # solved after the blocks (below)
                 if deferred_count == deferred.shape[0]:
                     grown = np.empty(2 * deferred.shape[0], dtype=np.int64)
@@ -1022,7 +1059,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     gap = 0.0
                     for j in range(5):
                         gap = max(gap, abs(c[_C_Q + j, ka] - c[_C_Q + j, kb]))
-                    for h in range(2 if gap >= DUPLICATE_TOLERANCE else 1):  # kb: a duplicate?
+                    pair = gap >= DUPLICATE_TOLERANCE  # else kb is a duplicate
+                    for h in range(2 if pair else 1):
                         k = kb if h else ka
                         b = slot_of[k]
                         for j in range(5):
@@ -1032,6 +1070,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                         position_error[n, b] = c[_C_PERR, k]
                         orientation_error[n, b] = c[_C_OERR, k]
                     solved[n] = True
+                    # the smallest error over the slots (``smallest_error``: the others empty)
+                    nearest = c[_C_PERR, ka]
+                    distance[n] = min(nearest, c[_C_PERR, kb]) if pair else nearest
                     continue
             count = np.int64(0)  # not a literal 0: one compile of is_duplicate
             scalar = False
@@ -1073,9 +1114,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 position_error[n, b] = err
                 orientation_error[n, b] = angle
             solved[n] = count > 0
+            distance[n] = smallest_error(position_error, n)
             fallbacks += 1 if scalar else 0
-        for i in range(m):  # the block's errors, just written: in cache
-            distance[start + i] = smallest_error(position_error, start + i)
     # the poses for the scalar solver, one after the other: its code and branch history stay
     # warm (between two blocks' vector loops each one cost ~2.5 times as much)
     for d in range(deferred_count):
