@@ -225,3 +225,64 @@ def test_full_poses_of_an_off_axis_tool_have_eight_slots() -> None:
     assert np.array_equal(
         np.where(packed.valid, packed.position_error, np.inf).min(axis=1), nearest
     )
+
+
+def _flips(robot: Robot, poses: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Per pose: |flip 1's roll + flip 0's| (each computed from the orientation), the flip the
+    screen picks, whether it marks the other, and both flips computed in full (candidate,
+    fallback: 1/0), as the kernel computed them before the screen."""
+    from lynxplan.robots.ik import pose_block as pb
+
+    family = robot.family
+    assert family is not None
+    pr = tuple(float(v) for v in family.packed)
+    shape = pb._shape(family.packed)
+    rows = []
+    for pose in poses:
+        t = tuple(float(v) for v in pose[:3, :4].reshape(-1))
+        roll0, roll1 = pb._roll(pr, shape, t, 0), pb._roll(pr, shape, t, 1)
+        one, later = pb._screen(pr, shape, t, roll0)
+        first = pb._flip(pr, shape, t, 0, False, roll0)
+        # _flip turns the roll it is given by pi for flip 1: given -roll1, it uses roll1
+        other = pb._flip(pr, shape, t, 1, False, (-roll1[0], -roll1[1]))
+        gap = max(abs(roll1[0] + roll0[0]), abs(roll1[1] + roll0[1]))
+        rows.append((gap, one, later, first[1], first[2], other[1], other[2]))
+    return tuple(np.array(column) for column in zip(*rows, strict=True))
+
+
+def _assert_screen_sound(robot: Robot, poses: np.ndarray) -> np.ndarray:
+    """The flip the screen leaves out is no candidate and sends no pose to the scalar solver
+    that the computed flip does not (both flips in full, with flip 1's roll computed afresh);
+    returns where the screen marked the other flip."""
+    gap, one, later, cand0, fall0, cand1, fall1 = _flips(robot, poses)
+    assert gap.max() <= 1e-14  # flip 1's roll is flip 0's turned by pi
+    left_cand = np.where(one == 0, cand1, cand0).astype(bool)
+    left_fall = np.where(one == 0, fall1, fall0).astype(bool)
+    kept_fall = np.where(one == 0, fall0, fall1).astype(bool)
+    free = ~later.astype(bool)
+    assert not left_cand[free].any()
+    assert not (left_fall & ~kept_fall)[free].any()
+    return later.astype(bool)
+
+
+def test_screen_leaves_out_only_flips_that_cannot_matter(tmp_path: Path) -> None:
+    """A tool off the roll axis: ``_screen`` computes one flip, and the other only where it
+    may matter; on the SO-101 (mixed poses: random, next to folds and the yaw axis, out of
+    reach, approaches along the yaw axis, arbitrary orientations) and random off-axis family
+    URDFs (exact and tilted). The other flip must be rare, or the screen saves nothing."""
+    from scipy.spatial.transform import Rotation
+
+    robot = load_robot("so101")
+    poses = _mixed_poses(robot, seed=41)
+    turned = poses[:500].copy()
+    turned[:, :3, :3] = Rotation.random(500, random_state=2).as_matrix()
+    later = _assert_screen_sound(robot, np.concatenate((poses, turned)))
+    random = robot.fk(robot.random_configurations(2000, seed=42))
+    assert _assert_screen_sound(robot, random).mean() <= 0.1  # measured: ~3 %
+    assert later.any()  # the marked poses exist (and the equality tests cover them)
+    for path in write_random_family_urdfs(tmp_path, 4, seed=11):
+        for urdf in (path, tilted_urdf(path)):
+            robot = load_robot(urdf, tool="tool")
+            assert robot.family is not None
+            if not robot.family.tool_on_roll_axis:
+                _assert_screen_sound(robot, _mixed_poses(robot, seed=6)[:800])

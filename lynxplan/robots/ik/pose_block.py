@@ -101,7 +101,8 @@ _FLIP0 = 12
 _F_CAND, _F_FALL, _F_SIDE, _F_FOLD = 12, 13, 14, 15
 _PER_FLIP = 16
 _POSE_FALL = _FLIP0 + 2 * _PER_FLIP
-_ROWS = _POSE_FALL + 1
+_POSE_OTHER = _POSE_FALL + 1  # 1 + the flip computed where the other is left (``_screen``)
+_ROWS = _POSE_OTHER + 1
 # Candidate scratch rows (up to 4 per pose): the target (12), q (5), near a fold, the error
 # before the last step, then taken, fallback, within (1/0), position, orientation error,
 # the closed-form q (5), and the sines and cosines of q (5 each) where the polish starts.
@@ -120,6 +121,12 @@ TAYLOR_STEP = 1e-3
 #: ... and up to which a candidate may be found not to be a branch: there the sines and cosines
 #: are within FAR_STEP^6 / 720 (1.4e-9) of the exact ones, far below NOT_A_BRANCH.
 FAR_STEP = 0.1
+#: The margin [m per m of distance from the yaw axis] of the test that leaves a flip out
+#: (``_screen``): ~1e5 times the rounding of the yaws it bounds.
+OTHER_MARGIN = 1e-9
+#: Both flips are computed where the approach's component along the yaw axis [1] or the
+#: target's distance from it [m] is within this of 0 (the pitch sum or yaw may be degenerate).
+OTHER_DEGENERATE = 1e-9
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -181,14 +188,115 @@ def _yaw(
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _roll(pr: Floats, shape: Floats, t: Floats, flip: int) -> Floats:
+    """(sin, cos) of the canonical roll nearest the target t (12) at flip ``flip``'s yaw (the
+    orientation's, turned by flip pi: ``_roll_terms``). Flip 1 turns the yaw by pi and the
+    pitch sum to its mirror: the same approach, the frame turned by pi about it, so its roll is
+    flip 0's turned by pi (the same to rounding, as the tests check): the kernels compute
+    flip 0's only."""
+    rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
+          pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
+    g0 = t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]
+    g1 = t[0] * rt[3] + t[1] * rt[4] + t[2] * rt[5]
+    g2 = t[0] * rt[6] + t[1] * rt[7] + t[2] * rt[8]
+    g3 = t[4] * rt[0] + t[5] * rt[1] + t[6] * rt[2]
+    g4 = t[4] * rt[3] + t[5] * rt[4] + t[6] * rt[5]
+    g5 = t[4] * rt[6] + t[5] * rt[7] + t[6] * rt[8]
+    g6 = t[8] * rt[0] + t[9] * rt[1] + t[10] * rt[2]
+    g7 = t[8] * rt[3] + t[9] * rt[4] + t[10] * rt[5]
+    g8 = t[8] * rt[6] + t[9] * rt[7] + t[10] * rt[8]
+    g = (g0, g1, g2, g3, g4, g5, g6, g7, g8)
+    a0 = g0 * pr[F.R] + g1 * pr[F.R + 1] + g2 * pr[F.R + 2]
+    a1 = g3 * pr[F.R] + g4 * pr[F.R + 1] + g5 * pr[F.R + 2]
+    a2 = g6 * pr[F.R] + g7 * pr[F.R + 1] + g8 * pr[F.R + 2]
+    a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
+    a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
+    a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
+    sign = 1.0 - 2.0 * flip
+    s_phi, c_phi = _unit(-a_p, a_h)
+    s_phi, c_phi = sign * s_phi, sign * c_phi
+    _, s_big, c_big, _ = _pitch_sum(shape, a_h, a_p, a_k, s_phi, c_phi)
+    return _roll_terms(pr, g, s_phi, c_phi, s_big, c_big)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _screen(pr: Floats, shape: Floats, t: Floats, roll: Floats) -> tuple[int, bool]:
+    """For a tool off the roll axis: the flip whose yaw the target's position can match (of
+    the smaller miss, below), and whether the other flip may be a candidate or send the pose
+    to the scalar solver too (then ``_other_flip`` computes it; rare: the other flip's yaw
+    misses by about twice the lateral offset over rho); roll: flip 0's (``_roll``).
+
+    A side's yaw y = alpha +- beta matches flip f's yaw phi_f (the orientation's, turned by
+    f pi) only where |y - phi_f| <= match_f (``yaw_match`` at flip f's lateral offset, the
+    value ``_flip`` uses). cos is 1-Lipschitz and rho cos(y - alpha) = clamp(lateral_f, -rho,
+    rho), so a match needs the miss |rho cos(phi_f - alpha) - clamp(lateral_f, -rho, rho)| <=
+    rho match_f (rho: the target's distance from the yaw axis [m]; lateral_f [m]: the lateral
+    offset at flip f's roll, flip 0's turned by pi), tested with a margin (OTHER_MARGIN) ~1e5
+    times the rounding. A flip's own fallbacks need an approach square to the yaw axis (the
+    pitch sum degenerate) or the target on the yaw axis (OTHER_DEGENERATE); the others are the
+    same for both flips."""
+    rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
+          pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
+    a0 = (t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]) * pr[F.R]
+    a0 += (t[0] * rt[3] + t[1] * rt[4] + t[2] * rt[5]) * pr[F.R + 1]
+    a0 += (t[0] * rt[6] + t[1] * rt[7] + t[2] * rt[8]) * pr[F.R + 2]
+    a1 = (t[4] * rt[0] + t[5] * rt[1] + t[6] * rt[2]) * pr[F.R]
+    a1 += (t[4] * rt[3] + t[5] * rt[4] + t[6] * rt[5]) * pr[F.R + 1]
+    a1 += (t[4] * rt[6] + t[5] * rt[7] + t[6] * rt[8]) * pr[F.R + 2]
+    a2 = (t[8] * rt[0] + t[9] * rt[1] + t[10] * rt[2]) * pr[F.R]
+    a2 += (t[8] * rt[3] + t[9] * rt[4] + t[10] * rt[5]) * pr[F.R + 1]
+    a2 += (t[8] * rt[6] + t[9] * rt[7] + t[10] * rt[8]) * pr[F.R + 2]
+    a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
+    a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
+    a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
+    axial = math.sqrt(a_h * a_h + a_p * a_p)
+    d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
+    dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
+    dh = d0 * pr[F.H] + d1 * pr[F.H + 1] + d2 * pr[F.H + 2]
+    rho = math.sqrt(dp * dp + dh * dh)
+    s_phi, c_phi = _unit(-a_p, a_h)
+    u = c_phi * dp + s_phi * dh  # rho cos(phi_0 - alpha)
+    centre = pr[F.LAM4] + pr[F.W0 + 2]
+    swing = roll[1] * pr[F.E1 + 2] + roll[0] * pr[F.E2 + 2]
+    miss0 = abs(u - min(max(centre + swing, -rho), rho))
+    miss1 = abs(-u - min(max(centre - swing, -rho), rho))
+    one = 0 if miss0 <= miss1 else 1
+    lateral = centre + swing if one else centre - swing  # the other flip's
+    match = yaw_match(pr[F.DEVIATION], shape[0] + shape[1], axial, rho, lateral)
+    tol = rho * match * (1.0 + 1e-6) + OTHER_MARGIN * max(1.0, rho)
+    later = max(miss0, miss1) <= tol
+    # a NaN anywhere: not <=, and flip 0's own tests (not finite) send the pose to the scalar
+    return one, later | (abs(a_k) <= OTHER_DEGENERATE) | (rho <= OTHER_DEGENERATE)
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _other_flip(pr: Floats, shape: Floats, x: np.ndarray, i: int) -> None:
+    """The flip of pose i that ``_closed_forms`` left out (``_screen``; its row _POSE_OTHER:
+    1 + the flip it computed) into the scratch rows x, and pose i's candidate lanes then from
+    flip 0 where it is a candidate, else from flip 1 (as for a tool on the roll axis)."""
+    t = _column_of(x, BLOCK, 0, i)
+    computed = 0 if x[_POSE_OTHER * BLOCK + i] == 1.0 else 1
+    missing = 1 - computed
+    _put_flip(x, i, missing, _flip(pr, shape, t, missing, False, _roll(pr, shape, t, 0)))
+    pick = 0 if x[(_FLIP0 + _F_CAND) * BLOCK + i] != 0.0 else 1
+    if pick != computed:  # the lanes hold the computed flip's branches
+        first = _FLIP0 + pick * _PER_FLIP
+        fold = x[(first + _F_FOLD) * BLOCK + i] != 0.0
+        up, down, s_up, c_up, s_down, c_down = _branches(pr, shape, _column_of(x, BLOCK, first, i))
+        _put_candidate(x, i, t, up, s_up, c_up, fold)
+        _put_candidate(x, BLOCK + i, t, down, s_down, c_down, fold)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _flip(  # noqa: PLR0915
-    pr: Floats, shape: Floats, t: Floats, flip: int, on_roll_axis: bool
+    pr: Floats, shape: Floats, t: Floats, flip: int, on_roll_axis: bool, roll: Floats
 ) -> FlipBranches:
     """One flip of the yaw (both elbows) of the target t (12: row-major 3 x 4) on the ideal
     model: (its geometry, where ``_branches`` finds the angles, candidate, fallback, side, near
     a fold of the elbow); on_roll_axis: the tool point on the roll axis (``F.OFF_AXIS`` 0: the
     roll is then the side's; a constant, so the roll of the other kind is not computed at all);
-    shape: (la, lb, b2, b3) of the two links
+    roll: flip 0's (sin, cos) of the roll the orientation gives (``_roll``; flip 1's is it
+    turned by pi); shape: (la, lb, b2, b3) of the two links
     (``family_geometry.two_link``), sin, cos and the angle gamma0, sin and cos of b2 and of
     b2 - b3.
 
@@ -226,8 +334,8 @@ def _flip(  # noqa: PLR0915
     phi = atan2(-a_p, a_h) + flip * math.pi
     s_phi, c_phi = _unit(-a_p, a_h)
     s_phi, c_phi = sign * s_phi, sign * c_phi
-    _, s_big, c_big, flat1 = _pitch_sum(shape, a_h, a_p, a_k, s_phi, c_phi)
-    st, ct = _roll_terms(pr, g, s_phi, c_phi, s_big, c_big)
+    flat1 = _pitch_sum(shape, a_h, a_p, a_k, s_phi, c_phi)[3]
+    st, ct = sign * roll[0], sign * roll[1]  # flip 1's roll is flip 0's turned by pi
     s_alpha, c_alpha = _unit(dh, dp)
     alpha = (atan2(dh, dp), s_alpha, c_alpha)
     lat = pr[F.LAM4] + pr[F.W0 + 2] + ct * pr[F.E1 + 2] + st * pr[F.E2 + 2]
@@ -593,8 +701,10 @@ def _closed_forms_on_roll_axis(pr: Floats, shape: Floats, x: np.ndarray) -> None
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _closed_forms_of(pr: Floats, shape: Floats, x: np.ndarray, on_roll_axis: bool) -> None:
-    """Both flips and elbows of the block's poses in the scratch rows (x[: _ROWS * BLOCK], row
-    k at x[k * BLOCK:]), and pose i's first candidate flip (flip 0 where it is a candidate, else
+    """Both flips (a tool off the roll axis: the flip ``_screen`` picks, the other left out:
+    no candidate, no fallback, unless ``_screen`` marks it for ``_other_flip``) and elbows of
+    the block's poses in the scratch rows (x[: _ROWS * BLOCK], row k at x[k * BLOCK:]), and
+    pose i's first candidate flip (flip 0 where it is a candidate, else
     flip 1) in the candidate rows (x[_ROWS * BLOCK:], row k at x[_ROWS * BLOCK + k * _CW:]):
     lane i its elbow up, lane BLOCK + i its elbow down (the target, q and its copy, the sines and
     cosines, near a fold, the flags cleared). One loop, no branch and no call (see the module
@@ -604,10 +714,20 @@ def _closed_forms_of(pr: Floats, shape: Floats, x: np.ndarray, on_roll_axis: boo
     target. on_roll_axis: a constant (``_flip``), one compiled loop for each kind of tool."""
     for i in range(BLOCK):
         t = _column_of(x, BLOCK, 0, i)
-        first = _flip(pr, shape, t, 0, on_roll_axis)
-        other = _flip(pr, shape, t, 1, on_roll_axis)
+        roll = _roll(pr, shape, t, 0)
+        if on_roll_axis:  # both flips are often branches: both computed
+            first = _flip(pr, shape, t, 0, on_roll_axis, roll)
+            other = _flip(pr, shape, t, 1, on_roll_axis, roll)
+            one, later = 0, False
+        else:  # the flip whose yaw the position can match; the other where it may (_screen)
+            one, later = _screen(pr, shape, t, roll)
+            chosen = _flip(pr, shape, t, one, on_roll_axis, roll)
+            none = (chosen[0], False, False, 0.0, False)
+            first = chosen if one == 0 else none
+            other = chosen if one == 1 else none
         _put_flip(x, i, 0, first)
         _put_flip(x, i, 1, other)
+        x[_POSE_OTHER * BLOCK + i] = (1.0 + one) if later else 0.0
         pick = first[1]  # flip 0 where it is a candidate (selects, scalar by scalar)
         g0, g1 = first[0], other[0]
         geometry = (
@@ -885,6 +1005,30 @@ def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True)
+def _shape(prm: np.ndarray) -> Floats:
+    """The two links' shape (``_flip``) from the packed parameters: their lengths la, lb [m],
+    their angles b2, b3 [rad], sin, cos of gamma0 and gamma0, sin and cos of b2 and of
+    b2 - b3."""
+    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
+    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
+    gamma0 = prm[F.GAMMA0]
+    b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
+    return (
+        math.hypot(l20, l21),
+        math.hypot(l30, l31),
+        b2,
+        b3,
+        math.sin(gamma0),
+        math.cos(gamma0),
+        gamma0,
+        math.sin(b2),
+        math.cos(b2),
+        math.sin(b2 - b3),
+        math.cos(b2 - b3),
+    )
+
+
+@numba.njit(cache=True, nogil=True)
 def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     prm: np.ndarray,
     placements: np.ndarray,
@@ -915,23 +1059,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     exact = prm[F.EXACT] != 0.0
     on_roll_axis = prm[F.OFF_AXIS] == 0.0
     lower, upper, tol = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5], prm[F.LIMIT_TOL]
-    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
-    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
-    gamma0 = prm[F.GAMMA0]
-    b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
-    shape = (
-        math.hypot(l20, l21),
-        math.hypot(l30, l31),
-        b2,
-        b3,
-        math.sin(gamma0),
-        math.cos(gamma0),
-        gamma0,
-        math.sin(b2),
-        math.cos(b2),
-        math.sin(b2 - b3),
-        math.cos(b2 - b3),
-    )
+    shape = _shape(prm)
     # the scratch rows and the candidate rows in one array (constant distances: ``_closed_forms``)
     x_flat = np.zeros(_ROWS * BLOCK + _C_ROWS * _CW)
     s_flat, c_flat = x_flat[: _ROWS * BLOCK], x_flat[_ROWS * BLOCK :]
@@ -961,6 +1089,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             _closed_forms_on_roll_axis(pr, shape, x_flat)
         else:
             _closed_forms(pr, shape, x_flat)
+            for i in range(m):  # the other flip where it may matter (rare: see _screen)
+                if s[_POSE_OTHER, i] != 0.0:
+                    _other_flip(pr, shape, x_flat, i)
         # the candidates of the poses that need no fallback, in the scalar solver's order: lane
         # i the elbow up and lane BLOCK + i the elbow down of pose i's first candidate flip
         # (written by _closed_forms), then the other flip where it is a candidate too (rare:
