@@ -7,7 +7,8 @@ elbow) is solved for the whole block by one loop without branches or calls, whic
 into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
 
 1. the closed form on the ideal model (yaw, pitch sum, roll, the side of the lateral offset
-   whose yaw matches, the two-link shoulder and elbow);
+   whose yaw matches, the two-link shoulder and elbow); for a tool off the roll axis, of the
+   flip of the yaw the position can match, the other flip only where it may (``_screen``);
 2. on a model only close to the family, a fixed polish on the exact chain: two Gauss-Newton
    steps (pose and geometric Jacobian, the normal equations by an LDL^T factorisation): from
    ~1e-6 away the error falls to ~1e-12, then below rounding (a chord step in place of the
@@ -188,12 +189,9 @@ def _yaw(
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _roll(pr: Floats, shape: Floats, t: Floats, flip: int) -> Floats:
-    """(sin, cos) of the canonical roll nearest the target t (12) at flip ``flip``'s yaw (the
-    orientation's, turned by flip pi: ``_roll_terms``). Flip 1 turns the yaw by pi and the
-    pitch sum to its mirror: the same approach, the frame turned by pi about it, so its roll is
-    flip 0's turned by pi (the same to rounding, as the tests check): the kernels compute
-    flip 0's only."""
+def _approach(pr: Floats, t: Floats) -> tuple[Floats, float, float, float, float, float, float]:
+    """The target t's (12) rotation in the family frame, G = Rt Rt0^T (9, row-major), its
+    approach a (the roll axis R turned by G, 3) and a's components along h, p and k."""
     rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
           pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
     g0 = t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]
@@ -212,6 +210,17 @@ def _roll(pr: Floats, shape: Floats, t: Floats, flip: int) -> Floats:
     a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
     a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
     a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
+    return g, a0, a1, a2, a_h, a_p, a_k
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _roll(pr: Floats, shape: Floats, t: Floats, flip: int) -> Floats:
+    """(sin, cos) of the canonical roll nearest the target t (12) at flip ``flip``'s yaw (the
+    orientation's, turned by flip pi: ``_roll_terms``). Flip 1 turns the yaw by pi and the
+    pitch sum to its mirror: the same approach, the frame turned by pi about it, so its roll is
+    flip 0's turned by pi (the same to rounding, as the tests check): the kernels compute
+    flip 0's only."""
+    g, _, _, _, a_h, a_p, a_k = _approach(pr, t)
     sign = 1.0 - 2.0 * flip
     s_phi, c_phi = _unit(-a_p, a_h)
     s_phi, c_phi = sign * s_phi, sign * c_phi
@@ -235,20 +244,7 @@ def _screen(pr: Floats, shape: Floats, t: Floats, roll: Floats) -> tuple[int, bo
     times the rounding. A flip's own fallbacks need an approach square to the yaw axis (the
     pitch sum degenerate) or the target on the yaw axis (OTHER_DEGENERATE); the others are the
     same for both flips."""
-    rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
-          pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
-    a0 = (t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]) * pr[F.R]
-    a0 += (t[0] * rt[3] + t[1] * rt[4] + t[2] * rt[5]) * pr[F.R + 1]
-    a0 += (t[0] * rt[6] + t[1] * rt[7] + t[2] * rt[8]) * pr[F.R + 2]
-    a1 = (t[4] * rt[0] + t[5] * rt[1] + t[6] * rt[2]) * pr[F.R]
-    a1 += (t[4] * rt[3] + t[5] * rt[4] + t[6] * rt[5]) * pr[F.R + 1]
-    a1 += (t[4] * rt[6] + t[5] * rt[7] + t[6] * rt[8]) * pr[F.R + 2]
-    a2 = (t[8] * rt[0] + t[9] * rt[1] + t[10] * rt[2]) * pr[F.R]
-    a2 += (t[8] * rt[3] + t[9] * rt[4] + t[10] * rt[5]) * pr[F.R + 1]
-    a2 += (t[8] * rt[6] + t[9] * rt[7] + t[10] * rt[8]) * pr[F.R + 2]
-    a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
-    a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
-    a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
+    _, _, _, _, a_h, a_p, a_k = _approach(pr, t)
     axial = math.sqrt(a_h * a_h + a_p * a_p)
     d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
     dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
@@ -288,7 +284,7 @@ def _other_flip(pr: Floats, shape: Floats, x: np.ndarray, i: int) -> None:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _flip(  # noqa: PLR0915
+def _flip(
     pr: Floats, shape: Floats, t: Floats, flip: int, on_roll_axis: bool, roll: Floats
 ) -> FlipBranches:
     """One flip of the yaw (both elbows) of the target t (12: row-major 3 x 4) on the ideal
@@ -304,24 +300,7 @@ def _flip(  # noqa: PLR0915
     that define them (normalised): arctangents only for the yaw (two of them shared by both
     flips), no sine or cosine; the other angles' arctangents are left to ``_branches``, for
     the flip that is taken."""
-    rt = (pr[F.RT0], pr[F.RT0 + 1], pr[F.RT0 + 2], pr[F.RT0 + 3], pr[F.RT0 + 4],
-          pr[F.RT0 + 5], pr[F.RT0 + 6], pr[F.RT0 + 7], pr[F.RT0 + 8])  # fmt: skip
-    g0 = t[0] * rt[0] + t[1] * rt[1] + t[2] * rt[2]
-    g1 = t[0] * rt[3] + t[1] * rt[4] + t[2] * rt[5]
-    g2 = t[0] * rt[6] + t[1] * rt[7] + t[2] * rt[8]
-    g3 = t[4] * rt[0] + t[5] * rt[1] + t[6] * rt[2]
-    g4 = t[4] * rt[3] + t[5] * rt[4] + t[6] * rt[5]
-    g5 = t[4] * rt[6] + t[5] * rt[7] + t[6] * rt[8]
-    g6 = t[8] * rt[0] + t[9] * rt[1] + t[10] * rt[2]
-    g7 = t[8] * rt[3] + t[9] * rt[4] + t[10] * rt[5]
-    g8 = t[8] * rt[6] + t[9] * rt[7] + t[10] * rt[8]
-    g = (g0, g1, g2, g3, g4, g5, g6, g7, g8)
-    a0 = g0 * pr[F.R] + g1 * pr[F.R + 1] + g2 * pr[F.R + 2]
-    a1 = g3 * pr[F.R] + g4 * pr[F.R + 1] + g5 * pr[F.R + 2]
-    a2 = g6 * pr[F.R] + g7 * pr[F.R + 1] + g8 * pr[F.R + 2]
-    a_h = a0 * pr[F.H] + a1 * pr[F.H + 1] + a2 * pr[F.H + 2]
-    a_p = a0 * pr[F.P] + a1 * pr[F.P + 1] + a2 * pr[F.P + 2]
-    a_k = a0 * pr[F.K] + a1 * pr[F.K + 1] + a2 * pr[F.K + 2]
+    g, a0, a1, a2, a_h, a_p, a_k = _approach(pr, t)
     axial_size = math.sqrt(a_h * a_h + a_p * a_p)
     axial = axial_size <= AXIAL_APPROACH
     d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
@@ -367,7 +346,7 @@ def _flip(  # noqa: PLR0915
     fold = abs(cosd) > 1.0 - FOLD_BAND
     miss = math.sqrt(reach * reach + lat_miss * lat_miss)
     candidate = (ok0 | ok1) & (miss <= REACH_MISS)
-    finite = math.isfinite(d0 + d1 + d2 + a0 + a1 + a2 + g0 + g4 + g8)
+    finite = math.isfinite(d0 + d1 + d2 + a0 + a1 + a2 + g[0] + g[4] + g[8])
     fallback = axial | flat1 | flat2 | on_axis | (ok0 & ok1) | (candidate & fold_start)
     fallback |= not finite
     x_pitch = c2 * a_h - s2 * a_p  # the pitch sum is atan2(a_k, x_pitch) - gamma0
