@@ -214,6 +214,18 @@ def _approach(pr: Floats, t: Floats) -> tuple[Floats, float, float, float, float
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _offset(pr: Floats, t: Floats) -> Floats:
+    """The target t's (12) point less the yaw axis' point C1 [m] (3), its components along
+    p, h and k, and rho, its distance from the yaw axis [m]."""
+    d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
+    dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
+    dh = d0 * pr[F.H] + d1 * pr[F.H + 1] + d2 * pr[F.H + 2]
+    dk = d0 * pr[F.K] + d1 * pr[F.K + 1] + d2 * pr[F.K + 2]
+    rho = math.sqrt(dp * dp + dh * dh)
+    return d0, d1, d2, dp, dh, dk, rho
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _roll(pr: Floats, shape: Floats, t: Floats, flip: int) -> Floats:
     """(sin, cos) of the canonical roll nearest the target t (12) at flip ``flip``'s yaw (the
     orientation's, turned by flip pi: ``_roll_terms``). Flip 1 turns the yaw by pi and the
@@ -246,10 +258,7 @@ def _screen(pr: Floats, shape: Floats, t: Floats, roll: Floats) -> tuple[int, bo
     same for both flips."""
     _, _, _, _, a_h, a_p, a_k = _approach(pr, t)
     axial = math.sqrt(a_h * a_h + a_p * a_p)
-    d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
-    dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
-    dh = d0 * pr[F.H] + d1 * pr[F.H + 1] + d2 * pr[F.H + 2]
-    rho = math.sqrt(dp * dp + dh * dh)
+    _, _, _, dp, dh, _, rho = _offset(pr, t)
     s_phi, c_phi = _unit(-a_p, a_h)
     u = c_phi * dp + s_phi * dh  # rho cos(phi_0 - alpha)
     centre = pr[F.LAM4] + pr[F.W0 + 2]
@@ -303,11 +312,7 @@ def _flip(
     g, a0, a1, a2, a_h, a_p, a_k = _approach(pr, t)
     axial_size = math.sqrt(a_h * a_h + a_p * a_p)
     axial = axial_size <= AXIAL_APPROACH
-    d0, d1, d2 = t[3] - pr[F.C1], t[7] - pr[F.C1 + 1], t[11] - pr[F.C1 + 2]
-    dp = d0 * pr[F.P] + d1 * pr[F.P + 1] + d2 * pr[F.P + 2]
-    dh = d0 * pr[F.H] + d1 * pr[F.H + 1] + d2 * pr[F.H + 2]
-    dk = d0 * pr[F.K] + d1 * pr[F.K + 1] + d2 * pr[F.K + 2]
-    rho = math.sqrt(dp * dp + dh * dh)
+    d0, d1, d2, dp, dh, dk, rho = _offset(pr, t)
     # the yaw that puts the approach in the arm plane, flipped by pi: its sine and cosine flip
     sign = 1.0 - 2.0 * flip
     phi = atan2(-a_p, a_h) + flip * math.pi
