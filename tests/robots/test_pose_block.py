@@ -173,22 +173,31 @@ def test_exact_branches_are_within_the_reach_tolerance() -> None:
     )
 
 
-def test_chain_turned_about_z_gives_the_same_poses() -> None:
-    """The kernel's chain (each joint turned about its own z axis) against ``chain_fk`` on
-    random placements and random unit axes (not only the URDFs' x/y/z)."""
+def test_sparse_chain_gives_the_same_poses() -> None:
+    """The kernel's chain (frames on the joint axes that make each link R(z, phi) R(x, beta)
+    with no translation along z, ``_chain_tuple``) against ``chain_fk``: random placements and
+    random unit axes (not only the URDFs' x/y/z), and chains with parallel axes, exactly (no
+    normal common to two axes: any is taken) and tilted by 1e-12 to 1e-4 rad (the common
+    normal from a tiny cross product), as in the family's pitch joints."""
     from scipy.spatial.transform import Rotation
 
     from lynxplan.robots.chain import chain_fk
     from lynxplan.robots.ik.pose_block import _chain_tuple, _fk
 
     rng = np.random.default_rng(12)
-    for _ in range(20):
+    for case in range(40):
         placements = np.tile(np.eye(4), (6, 1, 1))
         placements[:, :3, :3] = Rotation.random(6, random_state=rng).as_matrix()
         placements[:, :3, 3] = rng.uniform(-0.2, 0.2, (6, 3))
         axes = rng.normal(size=(5, 3))
         axes /= np.linalg.norm(axes, axis=1)[:, None]
         axes[rng.uniform(size=5) < 0.4] = [0.0, 0.0, -1.0]
+        if case >= 20:  # joints 2-4 about parallel axes, exactly or nearly
+            tilt = 0.0 if case < 25 else 10.0 ** rng.uniform(-12, -4)
+            for k in (2, 3):
+                turn = Rotation.from_rotvec(tilt * Rotation.random(random_state=rng).as_rotvec())
+                placements[k, :3, :3] = turn.as_matrix()
+                axes[k] = axes[1]
         chain = _chain_tuple(placements, axes)
         for q in rng.uniform(-np.pi, np.pi, (10, 5)):
             expected = np.empty((4, 4))

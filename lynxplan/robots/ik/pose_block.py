@@ -93,7 +93,7 @@ FOLD_BAND = 1e-3
 #: A candidate whose normal matrix is this ill-conditioned (smallest over largest LDL^T pivot) is
 #: finished by the scalar polish.
 ILL_CONDITIONED = 1e-8
-_N_CHAIN = 6 * 12  # the 3 x 4 blocks of M'_1..M'_5, M'_tool (see ``_chain_tuple``)
+_N_CHAIN = 12 + 4 * 6 + 12  # the base, four joint-to-joint links, the tool (``_chain_tuple``)
 _N_PRM = F.N_PARAMS
 
 # Pose scratch rows: the target (row-major 3 x 4), then per flip: its geometry (12: ``_flip``),
@@ -424,14 +424,37 @@ def _elbow_terms(
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _joint_turned(ch: Floats, j: int, t: Floats, s: float, c: float) -> Floats:
-    """The running pose t (12: row-major 3 x 4) times R(z, q) M'_{j+1} for the angle q of sine
-    s and cosine c; ch: the chain tuple (``_chain_tuple``: every joint turned about its own z
-    axis). j must be a literal (a constant index into ch)."""
+    """The running pose t (12: row-major 3 x 4) times R(z, q) N_{j+2} for the angle q of sine s
+    and cosine c; ch: the chain tuple (``_chain_tuple``). Between two joints N = R(z, phi)
+    R(x, beta) with a translation (px, py, 0) in the frame turned by q + phi: (cos phi, sin phi,
+    cos beta, sin beta, px, py); after the last joint the tool's 3 x 4 block. j must be a
+    literal (a constant index into ch)."""
+    if j < 4:
+        b = 12 + 6 * j
+        cb, sb, px, py = ch[b + 2], ch[b + 3], ch[b + 4], ch[b + 5]
+        w00, w01 = c * t[0] + s * t[1], c * t[1] - s * t[0]
+        w10, w11 = c * t[4] + s * t[5], c * t[5] - s * t[4]
+        w20, w21 = c * t[8] + s * t[9], c * t[9] - s * t[8]
+        w02, w12, w22 = t[2], t[6], t[10]
+        return (
+            w00,
+            cb * w01 + sb * w02,
+            cb * w02 - sb * w01,
+            w00 * px + w01 * py + t[3],
+            w10,
+            cb * w11 + sb * w12,
+            cb * w12 - sb * w11,
+            w10 * px + w11 * py + t[7],
+            w20,
+            cb * w21 + sb * w22,
+            cb * w22 - sb * w21,
+            w20 * px + w21 * py + t[11],
+        )
     w00, w01 = c * t[0] + s * t[1], c * t[1] - s * t[0]
     w10, w11 = c * t[4] + s * t[5], c * t[5] - s * t[4]
     w20, w21 = c * t[8] + s * t[9], c * t[9] - s * t[8]
     w02, w12, w22 = t[2], t[6], t[10]
-    b = 12 * (j + 1)
+    b = 36
     m00, m01, m02, m03 = ch[b], ch[b + 1], ch[b + 2], ch[b + 3]
     m10, m11, m12, m13 = ch[b + 4], ch[b + 5], ch[b + 6], ch[b + 7]
     m20, m21, m22, m23 = ch[b + 8], ch[b + 9], ch[b + 10], ch[b + 11]
@@ -460,7 +483,7 @@ def _axis_of(t: Floats) -> Floats:
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _base(ch: Floats) -> Floats:
-    """M'_1, the first joint's placement (12: row-major 3 x 4), where every pose starts."""
+    """N_1 (``_chain_tuple``: 12, row-major 3 x 4), where every pose starts."""
     return ch[0], ch[1], ch[2], ch[3], ch[4], ch[5], ch[6], ch[7], ch[8], ch[9], ch[10], ch[11]
 
 
@@ -472,7 +495,18 @@ def _fk(ch: Floats, q0: float, q1: float, q2: float, q3: float, q4: float) -> Fl
     s2, c2 = sincos(q2)
     s3, c3 = sincos(q3)
     s4, c4 = sincos(q4)
-    return _fk_turned(ch, (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4))
+    sn, cs = _offsets(ch, (s0, s1, s2, s3, s4), (c0, c1, c2, c3, c4))
+    return _fk_turned(ch, sn, cs)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _offsets(ch: Floats, sn: Floats, cs: Floats) -> tuple[Floats, Floats]:
+    """The sines and cosines of q + phi (``_chain_tuple``: phi of joint 1 and joint 5 is 0) from
+    those of q (5 each), which ``_joint_turned`` takes."""
+    s1, c1 = sn[1] * ch[18] + cs[1] * ch[19], cs[1] * ch[18] - sn[1] * ch[19]
+    s2, c2 = sn[2] * ch[24] + cs[2] * ch[25], cs[2] * ch[24] - sn[2] * ch[25]
+    s3, c3 = sn[3] * ch[30] + cs[3] * ch[31], cs[3] * ch[30] - sn[3] * ch[31]
+    return (sn[0], s1, s2, s3, sn[4]), (cs[0], c1, c2, c3, cs[4])
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
@@ -871,7 +905,7 @@ def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     wide_vectors()
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
-        sines, cosines = _column_of5(c, _C_SIN, i), _column_of5(c, _C_COS, i)
+        sines, cosines = _offsets(ch, _column_of5(c, _C_SIN, i), _column_of5(c, _C_COS, i))
         q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i), sines, cosines)
         w0, w1, w2, w3, w4, inside = _wrapped(pr, q)
         r0, r1, r2 = _snap(q[0], w0), _snap(q[1], w1), _snap(q[2], w2)
@@ -959,31 +993,69 @@ def _clear_slots(
 
 @numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
-    """The chain with every joint turned about its own z axis, as one tuple of the 3 x 4 blocks
-    of M'_1 .. M'_5, M'_tool (row-major; placements (6, 4, 4), axes (5, 3)).
+    """The chain in frames that make each link between two joints sparse, as one tuple: the
+    base block G_1 (3 x 4, row-major), four links (6 each, ``_joint_turned``), the tool block
+    (3 x 4); placements (6, 4, 4), axes (5, 3).
 
-    With A_i a rotation taking z to the joint axis u_i, R(u_i, q) = A_i R(z, q) A_i^T, so
-    T(q) = M'_1 R(z, q_1) M'_2 ... R(z, q_5) M'_tool with M'_1 = M_1 A_1, M'_i = A_{i-1}^T M_i A_i
-    and M'_tool = A_5^T M_tool: the same poses, and each joint rotation mixes two columns only.
+    T(q) = M_1 R(u_1, q_1) M_2 ... R(u_5, q_5) M_tool with G_i = [A_i | lambda_i u_i] a frame on
+    joint i's axis (A_i takes z to u_i) and R(u_i, q) = G_i R(z, q) G_i^-1:
+    T(q) = N_1 R(z, q_1) N_2 ... R(z, q_5) N_tool, N_1 = M_1 G_1, N_i = G_{i-1}^-1 M_i G_i,
+    N_tool = G_5^-1 M_tool. Frame i's x axis is normal to both joint axes i - 1 and i (any
+    normal to u_i where they are parallel) and frame 1's is frame 2's, so N_i's rotation is
+    R(z, phi_i) R(x, beta_i) (phi_2 = 0); lambda_i puts frame i's origin where N_{i+1} has no
+    translation along z (back from the tool). The same poses to rounding: the fourth entries
+    (N_i's z-x rotation entry and z translation) are rounding, left out.
     """
-    frames = np.zeros((6, 3, 3))  # A_i (columns x', y', u_i); frames[5]: identity for the tool
-    for k in range(5):
-        u = axes[k]
-        a = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
-        x = a - (a @ u) * u
+    frames = np.zeros((5, 4, 4))
+    xs = np.zeros((5, 3))
+    for k in range(4, -1, -1):
+        u = axes[k].copy()
+        w = np.zeros(3)
+        if k >= 1:  # normal to u and to the axis before it (in joint k's frame)
+            v = np.ascontiguousarray(placements[k, :3, :3]).T @ axes[k - 1]
+            w = v - (v @ u) * u
+        if k >= 1 and w @ w > 1e-300:
+            x = np.cross(u, w)
+        elif k == 0:  # frame 2's x axis in joint 1's frame: phi_2 = 0
+            x = np.ascontiguousarray(placements[1, :3, :3]) @ xs[1]
+        else:  # parallel: any normal
+            a = np.array([1.0, 0.0, 0.0]) if abs(u[0]) < 0.9 else np.array([0.0, 1.0, 0.0])
+            x = a - (a @ u) * u
+        x = x - (x @ u) * u
         x /= math.sqrt(x @ x)
-        y = np.cross(u, x)
-        frames[k, :, 0], frames[k, :, 1], frames[k, :, 2] = x, y, u
-    frames[5] = np.eye(3)
+        xs[k] = x
+        frames[k, :3, 0], frames[k, :3, 1], frames[k, :3, 2] = x, np.cross(u, x), u
+        frames[k, 3, 3] = 1.0
+    # lambda: back from the tool, each frame's origin where the next link has no z translation
+    lam = np.zeros(5)
+    lam[4] = axes[4] @ np.ascontiguousarray(placements[5, :3, 3])
+    for k in range(3, -1, -1):
+        m = placements[k + 1]
+        lam[k] = axes[k] @ (np.ascontiguousarray(m[:3, :3]) @ (lam[k + 1] * axes[k + 1]) + m[:3, 3])
+    for k in range(5):
+        frames[k, :3, 3] = lam[k] * axes[k]
+    inverse = np.zeros((5, 4, 4))
+    for k in range(5):
+        r = frames[k, :3, :3].T.copy()
+        inverse[k, :3, :3] = r
+        inverse[k, :3, 3] = -(r @ np.ascontiguousarray(frames[k, :3, 3]))
+        inverse[k, 3, 3] = 1.0
     flat = np.empty(_N_CHAIN)
-    for k in range(6):
-        before = np.eye(3) if k == 0 else frames[k - 1].T.copy()
-        rotation = before @ np.ascontiguousarray(placements[k, :3, :3]) @ frames[k]
-        translation = before @ np.ascontiguousarray(placements[k, :3, 3])
-        for r in range(3):
-            for col in range(3):
-                flat[12 * k + 4 * r + col] = rotation[r, col]
-            flat[12 * k + 4 * r + 3] = translation[r]
+    base = np.ascontiguousarray(placements[0]) @ frames[0]
+    tool = inverse[4] @ np.ascontiguousarray(placements[5])
+    for r in range(3):
+        for col in range(4):
+            flat[4 * r + col] = base[r, col]
+            flat[36 + 4 * r + col] = tool[r, col]
+    for k in range(1, 5):
+        link = inverse[k - 1] @ np.ascontiguousarray(placements[k]) @ frames[k]
+        cf, sf = link[0, 0], link[1, 0]
+        b = 12 + 6 * (k - 1)
+        flat[b], flat[b + 1] = cf, sf
+        flat[b + 2], flat[b + 3] = link[2, 2], link[2, 1]
+        # the translation in the frame turned by phi: R(z, -phi) (tx, ty)
+        tx, ty = link[0, 3], link[1, 3]
+        flat[b + 4], flat[b + 5] = cf * tx + sf * ty, cf * ty - sf * tx
     chain: Floats = to_fixed_tuple(flat, _N_CHAIN)  # type: ignore[call-arg]
     return chain
 
