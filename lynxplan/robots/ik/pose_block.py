@@ -424,11 +424,12 @@ def _elbow_terms(
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _joint_turned(ch: Floats, j: int, t: Floats, s: float, c: float) -> Floats:
-    """The running pose t (12: row-major 3 x 4) times R(z, q) N_{j+2} for the angle q of sine s
-    and cosine c; ch: the chain tuple (``_chain_tuple``). Between two joints N = R(z, phi)
-    R(x, beta) with a translation (px, py, 0) in the frame turned by q + phi: (cos phi, sin phi,
-    cos beta, sin beta, px, py); after the last joint the tool's 3 x 4 block. j must be a
-    literal (a constant index into ch)."""
+    """The running pose t (12: row-major 3 x 4) times R(z, q_{j+1}) N_{j+2} (N_tool after the
+    last joint); ch: the chain tuple (``_chain_tuple``). Between two joints, N = R(z, phi)
+    R(x, beta) with a translation (px, py, 0) in the frame turned by q + phi, stored as (cos phi,
+    sin phi, cos beta, sin beta, px, py): s and c are then the sine and cosine of q + phi
+    (``_offsets``), and only beta and the translation are applied here; the tool's is a 3 x 4
+    block. j must be a literal (a constant index into ch)."""
     if j < 4:
         b = 12 + 6 * j
         cb, sb, px, py = ch[b + 2], ch[b + 3], ch[b + 4], ch[b + 5]
