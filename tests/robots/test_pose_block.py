@@ -118,6 +118,58 @@ def test_block_kernel_equals_scalar_kernel_on_random_family_urdfs(tmp_path: Path
             _assert_same(scalar, block)
 
 
+def test_parallel_pitch_steps_are_the_normal_equations_steps(tmp_path: Path) -> None:
+    """Where the pitch axes are parallel (of either sign) the polish takes its Gauss-Newton
+    steps from the family's structure (``_newton_parallel``): the same steps as the normal
+    equations' (``_newton_ldl``), on random family URDFs with the roll axis tilted (a model
+    only close to the family whose pitch axes stay parallel, as the SO-101) and on the SO-101,
+    from starts ~1e-5 off random configurations; the block kernel, which then takes them,
+    still equals the scalar one. A tilted pitch axis takes the normal equations."""
+    import numba
+
+    from lynxplan.robots.ik.pose_block import (
+        _chain_tuple,
+        _newton_ldl,
+        _newton_parallel,
+        _offsets,
+        _parallel_pitches,
+    )
+
+    @numba.njit(cache=False)
+    def steps(ch, t, q):  # type: ignore[no-untyped-def]
+        s, c = np.sin(q), np.cos(q)
+        sn, cs = _offsets(ch, (s[0], s[1], s[2], s[3], s[4]), (c[0], c[1], c[2], c[3], c[4]))
+        qq = (q[0], q[1], q[2], q[3], q[4])
+        return _newton_parallel(ch, t, qq, sn, cs), _newton_ldl(ch, t, qq, sn, cs)
+
+    rng = np.random.default_rng(21)
+    worst: list[float] = []
+    paths = write_random_family_urdfs(tmp_path, 6, seed=11)
+    robots = [load_robot(tilted_urdf(path, joint="j5"), tool="tool") for path in paths]
+    for robot in [*robots, load_robot("so101")]:
+        assert robot.family is not None and not robot.family.exact
+        ch = _chain_tuple(robot.chain.placements, robot.chain.axes)
+        assert _parallel_pitches(ch)
+        q = robot.random_configurations(100, seed=3)
+        poses = robot.fk(q)
+        for n in range(q.shape[0]):
+            t = tuple(poses[n, :3].reshape(-1))
+            mine, normal = steps(ch, t, q[n] + rng.normal(scale=1e-5, size=5))
+            x, y = np.array(mine[:5]), np.array(normal[:5])
+            worst.append(np.abs(x - y).max() / np.abs(y).max())  # relative to the step
+            assert mine[6] == normal[6]  # the same pose error
+        if robot.name != "so101":
+            scalar, block, _ = _both(robot, _mixed_poses(robot, seed=5), robot._default_reference)
+            _assert_same(scalar, block)
+    # the same steps but for rounding, which the normal equations raise to cond(J)^2 eps
+    # where the arm is near a singularity (a few starts)
+    assert np.median(worst) <= 1e-12
+    assert np.quantile(worst, 0.99) <= 1e-9
+    assert max(worst) <= 1e-6
+    tilted = load_robot(tilted_urdf(paths[0]), tool="tool")
+    assert not _parallel_pitches(_chain_tuple(tilted.chain.placements, tilted.chain.axes))
+
+
 def test_vector_path_carries_the_load() -> None:
     """On random reachable SO-101 poses at most 1 % fall back to the scalar solver (~0.15 % with
     the second vector polish of the candidates next to a fold): a vector path that stopped taking

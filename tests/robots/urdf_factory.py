@@ -115,13 +115,17 @@ def write_random_family_urdfs(folder: Path, count: int, seed: int) -> list[Path]
     return paths
 
 
-def tilted_urdf(path: Path, angle: float = 4e-6) -> Path:
-    """The URDF with joint 3's axis tilted by angle [rad], as real URDFs' rounded angles tilt
-    them (the SO-101: 3.7e-6 rad): a model only close to the family, whose branches are polished."""
+def tilted_urdf(path: Path, angle: float = 4e-6, joint: str = "j3") -> Path:
+    """The URDF with a joint's axis tilted by angle [rad], as real URDFs' rounded angles tilt
+    them (the SO-101: 3.7e-6 rad): a model only close to the family, whose branches are
+    polished. Joint 3 (its built-in roll): the pitch axes no longer parallel; joint 5 (its
+    built-in yaw): the roll axis no longer square to the pitch axes, as in the SO-101."""
     text = path.read_text()
-    start = text.index('<joint name="j3"')
+    start = text.index(f'<joint name="{joint}"')
     at = text.index('rpy="', start) + len('rpy="')
-    roll_end = text.index(" ", at)
-    tilted = path.with_name("tilted_" + path.name)
-    tilted.write_text(text[:at] + repr(float(text[at:roll_end]) + angle) + text[roll_end:])
+    end = text.index('"', at)
+    rpy = [float(v) for v in text[at:end].split()]
+    rpy[0 if joint == "j3" else 2] += angle
+    tilted = path.with_name(f"tilted_{joint}_" + path.name)
+    tilted.write_text(text[:at] + " ".join(map(repr, rpy)) + text[end:])
     return tilted

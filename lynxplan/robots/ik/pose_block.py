@@ -10,10 +10,11 @@ into vector instructions (the layout of :mod:`lynxplan.arm.ik_kernel`):
    whose yaw matches, the two-link shoulder and elbow); for a tool off the roll axis, of the
    flip of the yaw the position can match, the other flip only where it may (``_screen``);
 2. on a model only close to the family, a fixed polish on the exact chain: two Gauss-Newton
-   steps (pose and geometric Jacobian, the normal equations by an LDL^T factorisation): from
-   ~1e-6 away the error falls to ~1e-12, then below rounding (a chord step in place of the
-   second left ~6 % of the SO-101's candidates above VECTOR_EXACT); candidates that start
-   farther away get a second polish, below;
+   steps (pose and geometric Jacobian; where the pitch axes are parallel, as in the SO-101,
+   solved by the family's structure, ``_newton_parallel``, else by an LDL^T factorisation of
+   the normal equations): from ~1e-6 away the error falls to ~1e-12, then below rounding (a
+   chord step in place of the second left ~6 % of the SO-101's candidates above
+   VECTOR_EXACT); candidates that start farther away get a second polish, below;
 3. the angles wrapped into the joint limits, and the pose of the exact chain at the final
    angles: the position and orientation errors that are reported. After a polish the sines
    and cosines of the final angles are carried from those of the start through each step and
@@ -90,9 +91,12 @@ VECTOR_EXACT = 1e-14
 NOT_A_BRANCH, STALLED = 1e-6, 0.5
 #: Next to a fold: |cos| of the elbow angle within this of 1 (an elbow ~0.045 rad from straight).
 FOLD_BAND = 1e-3
-#: A candidate whose normal matrix is this ill-conditioned (smallest over largest LDL^T pivot) is
-#: finished by the scalar polish.
+#: A candidate whose step is this ill-conditioned (``_newton_ldl``: smallest over largest LDL^T
+#: pivot of J^T J; ``_newton_parallel``: its two measures) is finished by the scalar polish.
 ILL_CONDITIONED = 1e-8
+#: Pitch axes parallel within this [rad] (and either sign) take ``_newton_parallel``'s steps:
+#: the same Gauss-Newton step to ~1e-10 of its size, by the family's structure.
+PARALLEL_PITCHES = 1e-10
 _N_CHAIN = 12 + 4 * 6 + 12  # the base, four joint-to-joint links, the tool (``_chain_tuple``)
 _N_PRM = F.N_PARAMS
 
@@ -633,10 +637,11 @@ def _stepped(q: Floats, sn: Floats, cs: Floats, x: Floats) -> tuple[Floats, Floa
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
-    """One Gauss-Newton step on the exact chain from q (5), whose sines sn and cosines cs are
-    given: the step x (5; the new angles are q - x), the smallest over the largest LDL^T pivot
-    of J^T J (its conditioning), and the largest component of the pose error at q."""
+def _fk_axes(
+    ch: Floats, sn: Floats, cs: Floats
+) -> tuple[Floats, Floats, Floats, Floats, Floats, Floats]:
+    """The origin and world axis of each joint (6 each, ``_axis_of``) and the tool pose (12)
+    of the chain at the angles of sines sn and cosines cs."""
     p = _base(ch)
     o0 = _axis_of(p)
     p = _joint_turned(ch, 0, p, sn[0], cs[0])
@@ -647,7 +652,15 @@ def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
     o3 = _axis_of(p)
     p = _joint_turned(ch, 3, p, sn[3], cs[3])
     o4 = _axis_of(p)
-    p = _joint_turned(ch, 4, p, sn[4], cs[4])
+    return o0, o1, o2, o3, o4, _joint_turned(ch, 4, p, sn[4], cs[4])
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _newton_ldl(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
+    """One Gauss-Newton step on the exact chain from q (5), whose sines sn and cosines cs are
+    given: the step x (5; the new angles are q - x), the smallest over the largest LDL^T pivot
+    of J^T J (its conditioning), and the largest component of the pose error at q."""
+    o0, o1, o2, o3, o4, p = _fk_axes(ch, sn, cs)
     j0, j1, j2 = _column(o0, p), _column(o1, p), _column(o2, p)
     j3, j4 = _column(o3, p), _column(o4, p)
     lower, inverse, ratio = _ldl(j0, j1, j2, j3, j4)
@@ -658,8 +671,109 @@ def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _cross(a0: float, a1: float, a2: float, b0: float, b1: float, b2: float) -> Floats:
+    """The cross product of (a0, a1, a2) and (b0, b1, b2)."""
+    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _newton_parallel(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
+    """``_newton_ldl``'s Gauss-Newton step (the same x = J^+ e, the same outputs; its
+    conditioning here: the smaller of two, below) for a chain whose pitch axes are parallel
+    (``_parallel_pitches``: each pitch column's axis is +-h, joint 3's), solved by the family's
+    structure instead of the 5 x 5 normal equations.
+
+    With the pitch angles' effects on the orientation summed (xs = s2 x2 + x3 + s4 x4 in the
+    signs s of the axes against h), the position across h is met exactly by the first two
+    pitch steps for any yaw, pitch-sum and roll steps (the pitch joints' origins span the plane
+    across h: a 2 x 2 system, singular at a fold of the elbow); so x0, xs, x4 are the least
+    squares solution of the four rows left, the orientation's and the position along h (3 x 3
+    normal equations, by cofactors), then the pitch steps follow from the 2 x 2. Conditioning:
+    the smaller of det N / (N00 N11 N22) of those normal equations and the squared sine of the
+    elbow's triangle of pitch origins."""
+    o0, o1, o2, o3, o4, p = _fk_axes(ch, sn, cs)
+    e = _error(p, t)
+    size = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]), abs(e[5]))
+    s1, s3 = _pitch_signs(ch)
+    k0, k1, k2 = o0[3], o0[4], o0[5]
+    h0, h1, h2 = o2[3], o2[4], o2[5]
+    a0, a1, a2 = o4[3], o4[4], o4[5]
+    px, py, pz = p[3], p[7], p[11]
+    v0 = _cross(k0, k1, k2, px - o0[0], py - o0[1], pz - o0[2])
+    v4 = _cross(a0, a1, a2, px - o4[0], py - o4[1], pz - o4[2])
+    v3 = _cross(h0, h1, h2, px - o3[0], py - o3[1], pz - o3[2])
+    x0, xs, x4, cond3 = _sum_steps(o0[3:], o2[3:], o4[3:], v0, v4, e)
+    # across h: h x (A y1 + B y2) = w, A and B from the pitch origins (y: the signed steps)
+    w0 = e[0] - v0[0] * x0 - v4[0] * x4 - v3[0] * xs
+    w1 = e[1] - v0[1] * x0 - v4[1] * x4 - v3[1] * xs
+    w2 = e[2] - v0[2] * x0 - v4[2] * x4 - v3[2] * xs
+    y = _cross(w0, w1, w2, h0, h1, h2)
+    b0, b1, b2 = o3[0] - o1[0], o3[1] - o1[1], o3[2] - o1[2]
+    d0, d1, d2 = o3[0] - o2[0], o3[1] - o2[1], o3[2] - o2[2]
+    bd = _cross(b0, b1, b2, d0, d1, d2)
+    det2 = bd[0] * h0 + bd[1] * h1 + bd[2] * h2
+    inv2 = 1.0 / det2
+    yd = _cross(y[0], y[1], y[2], d0, d1, d2)
+    by = _cross(b0, b1, b2, y[0], y[1], y[2])
+    y1 = (yd[0] * h0 + yd[1] * h1 + yd[2] * h2) * inv2
+    y2 = (by[0] * h0 + by[1] * h1 + by[2] * h2) * inv2
+    lengths = (b0 * b0 + b1 * b1 + b2 * b2) * (d0 * d0 + d1 * d1 + d2 * d2)
+    ratio = min(cond3, det2 * det2 / lengths)
+    return x0, s1 * y1, y2, s3 * (xs - y1 - y2), x4, ratio, size
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _sum_steps(k: Floats, h: Floats, a: Floats, v0: Floats, v4: Floats, e: Floats) -> Floats:
+    """(``_newton_parallel``) The yaw, pitch-sum and roll steps x0, xs, x4: the least squares
+    solution of the orientation's rows (axes k, h, a: 3 each) and the position's along h
+    (v0, v4: the yaw and roll columns' position parts; e: the pose error, 6), by the
+    cofactors of the 3 x 3 normal equations N; and det N / (N00 N11 N22)."""
+    k0, k1, k2, h0, h1, h2, a0, a1, a2 = k[0], k[1], k[2], h[0], h[1], h[2], a[0], a[1], a[2]
+    g0, g2 = h0 * v0[0] + h1 * v0[1] + h2 * v0[2], h0 * v4[0] + h1 * v4[1] + h2 * v4[2]
+    eh = h0 * e[0] + h1 * e[1] + h2 * e[2]
+    n00, n11, n22 = 1.0 + g0 * g0, 1.0, 1.0 + g2 * g2
+    n01 = k0 * h0 + k1 * h1 + k2 * h2
+    n02 = k0 * a0 + k1 * a1 + k2 * a2 + g0 * g2
+    n12 = h0 * a0 + h1 * a1 + h2 * a2
+    r0 = k0 * e[3] + k1 * e[4] + k2 * e[5] + g0 * eh
+    r1 = h0 * e[3] + h1 * e[4] + h2 * e[5]
+    r2 = a0 * e[3] + a1 * e[4] + a2 * e[5] + g2 * eh
+    c00, c11, c22 = n11 * n22 - n12 * n12, n00 * n22 - n02 * n02, n00 * n11 - n01 * n01
+    c01, c02, c12 = n02 * n12 - n01 * n22, n01 * n12 - n02 * n11, n01 * n02 - n00 * n12
+    det = n00 * c00 + n01 * c01 + n02 * c02
+    inverse = 1.0 / det
+    x0 = (c00 * r0 + c01 * r1 + c02 * r2) * inverse
+    xs = (c01 * r0 + c11 * r1 + c12 * r2) * inverse
+    x4 = (c02 * r0 + c12 * r1 + c22 * r2) * inverse
+    return x0, xs, x4, det / (n00 * n11 * n22)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _pitch_signs(ch: Floats) -> tuple[float, float]:
+    """The signs of joints 2 and 4's axes against joint 3's (the cosines of beta of the links
+    2-3 and 3-4 in ``_chain_tuple``; +-1 where the pitch axes are parallel)."""
+    return math.copysign(1.0, ch[20]), math.copysign(1.0, ch[26])
+
+
+@numba.njit(cache=True, nogil=True)
+def _parallel_pitches(ch: Floats) -> bool:
+    """Whether the pitch axes are parallel within PARALLEL_PITCHES (the sines of beta of the
+    links 2-3 and 3-4 in ``_chain_tuple``): then ``_newton_parallel`` takes the steps."""
+    return (abs(ch[21]) <= PARALLEL_PITCHES) & (abs(ch[27]) <= PARALLEL_PITCHES)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats, parallel: bool) -> Floats:
+    """One Gauss-Newton step (``_newton_ldl``; ``_newton_parallel`` where the pitch axes are
+    parallel: parallel must be a constant)."""
+    if parallel:
+        return _newton_parallel(ch, t, q, sn, cs)
+    return _newton_ldl(ch, t, q, sn, cs)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _polish(
-    ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats
+    ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats, parallel: bool
 ) -> tuple[Floats, Floats, Floats, float, float, float]:
     """Two Gauss-Newton steps on the exact chain from q (5) of sines sn and cosines cs: the
     final q, its sines and cosines, the smaller of the two conditionings (``_newton``), the
@@ -669,10 +783,10 @@ def _polish(
     The sines and cosines after each step follow from the ones before it (``_turn``): exact to
     rounding where the steps are within TAYLOR_STEP, and still good enough for the second
     step's direction where they are not."""
-    x0, x1, x2, x3, x4, first, _ = _newton(ch, t, q, sn, cs)
+    x0, x1, x2, x3, x4, first, _ = _newton(ch, t, q, sn, cs, parallel)
     big = max(abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
     q, sn, cs = _stepped(q, sn, cs, (x0, x1, x2, x3, x4))
-    x0, x1, x2, x3, x4, second, size = _newton(ch, t, q, sn, cs)
+    x0, x1, x2, x3, x4, second, size = _newton(ch, t, q, sn, cs, parallel)
     big = max(big, abs(x0), abs(x1), abs(x2), abs(x3), abs(x4))
     q, sn, cs = _stepped(q, sn, cs, (x0, x1, x2, x3, x4))
     return q, sn, cs, min(first, second), size, big
@@ -897,17 +1011,31 @@ def _settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
 
 @numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
 def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
+    """``_polish_settle_all_of`` with the normal equations' steps (``_newton_ldl``)."""
+    wide_vectors()
+    _polish_settle_all_of(m, pr, ch, c, False)
+
+
+@numba.njit(cache=True, nogil=True, fastmath=_FAST, error_model="numpy")
+def _polish_settle_all_parallel(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
+    """``_polish_settle_all_of`` with the steps of parallel pitch axes (``_newton_parallel``)."""
+    wide_vectors()
+    _polish_settle_all_of(m, pr, ch, c, True)
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+def _polish_settle_all_of(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel: bool) -> None:
     """The polish (``_polish``) of the m candidates in the rows c (flat: row k is c[k * _CW:];
     a model only close to the family), the error before its last step, the angles wrapped into
     the limits, and the verdict (``_verdict``) at the final angles, whose sines and cosines
     follow from the polish's by what the limits snapped (``_turn``): only where every step
     and snap is within TAYLOR_STEP is a candidate taken, within FAR_STEP found not to be a
-    branch; the others, and an ill-conditioned polish, are left to the second polish."""
-    wide_vectors()
+    branch; the others, and an ill-conditioned polish, are left to the second polish.
+    parallel: a constant (``_newton``)."""
     for i in range(m):
         t = _column_of(c, _CW, 0, i)
         sines, cosines = _offsets(ch, _column_of5(c, _C_SIN, i), _column_of5(c, _C_COS, i))
-        q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i), sines, cosines)
+        q, sn, cs, ratio, size, big = _polish(ch, t, _angles_of(c, i), sines, cosines, parallel)
         w0, w1, w2, w3, w4, inside = _wrapped(pr, q)
         r0, r1, r2 = _snap(q[0], w0), _snap(q[1], w1), _snap(q[2], w2)
         r3, r4 = _snap(q[3], w3), _snap(q[4], w4)
@@ -933,7 +1061,13 @@ def _polish_settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
 
 @numba.njit(cache=True, nogil=True)
 def _repolish(
-    m: int, pr: Floats, ch: Floats, c_flat: np.ndarray, c2_flat: np.ndarray, index: np.ndarray
+    m: int,
+    pr: Floats,
+    ch: Floats,
+    c_flat: np.ndarray,
+    c2_flat: np.ndarray,
+    index: np.ndarray,
+    parallel: bool,
 ) -> None:
     """The m candidates in the rows c_flat that the polish left unfinished next to a branch
     (final errors below NOT_A_BRANCH: next to a fold of the elbow the steps converge
@@ -955,7 +1089,10 @@ def _repolish(
             c2[row, j] = c[row, k]
         for row in range(5):  # the sines and cosines where the first polish stopped
             c2[_C_SIN + row, j], c2[_C_COS + row, j] = sincos(c2[_C_Q + row, j])
-    _polish_settle_all(lanes, pr, ch, c2_flat)
+    if parallel:
+        _polish_settle_all_parallel(lanes, pr, ch, c2_flat)
+    else:
+        _polish_settle_all(lanes, pr, ch, c2_flat)
     for j in range(count):
         if c2[_C_TAKE, j] == 0.0:
             continue
@@ -1112,6 +1249,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     nb = q_out.shape[1]
     per_side = nb // 2
     ch = _chain_tuple(placements, axes)
+    parallel = _parallel_pitches(ch)
     pr: Floats = to_fixed_tuple(prm, _N_PRM)  # type: ignore[call-arg]
     exact = prm[F.EXACT] != 0.0
     on_roll_axis = prm[F.OFF_AXIS] == 0.0
@@ -1209,13 +1347,15 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 c[k, lane] = c[k, 0]
         if exact:
             _settle_all(lanes, pr, ch, c_flat)
+        elif parallel:
+            _polish_settle_all_parallel(lanes, pr, ch, c_flat)
         else:
             _polish_settle_all(lanes, pr, ch, c_flat)
         for i in range(BLOCK):  # the lanes of no candidate (no flip, past m): nothing to finish
             if i >= m or owned[i] == 0:
                 c[_C_FALL, i] = c[_C_FALL, BLOCK + i] = 0.0
         if not exact:
-            _repolish(mc, pr, ch, c_flat, c2_flat, slot_index)
+            _repolish(mc, pr, ch, c_flat, c2_flat, slot_index, parallel)
         _clear_slots(start * nb, (start + m) * nb, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             n = start + i
