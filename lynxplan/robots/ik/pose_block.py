@@ -775,10 +775,10 @@ def _newton(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats, parallel: 
 def _polish(
     ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats, parallel: bool
 ) -> tuple[Floats, Floats, Floats, float, float, float]:
-    """Two Gauss-Newton steps on the exact chain from q (5) of sines sn and cosines cs: the
-    final q, its sines and cosines, the smaller of the two conditionings (``_newton``), the
-    largest component of the pose error before the last step, and the largest step [rad] of
-    either.
+    """Two Gauss-Newton steps on the exact chain from q (5), sn and cs the sines and cosines of
+    q + phi (``_offsets``): the final q, those sines and cosines, the smaller of the two
+    conditionings (``_newton``; parallel: a constant), the largest component of the pose error
+    before the last step, and the largest step [rad] of either.
 
     The sines and cosines after each step follow from the ones before it (``_turn``): exact to
     rounding where the steps are within TAYLOR_STEP, and still good enough for the second
