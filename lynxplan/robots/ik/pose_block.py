@@ -657,9 +657,10 @@ def _fk_axes(
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _newton_ldl(ch: Floats, t: Floats, q: Floats, sn: Floats, cs: Floats) -> Floats:
-    """One Gauss-Newton step on the exact chain from q (5), whose sines sn and cosines cs are
-    given: the step x (5; the new angles are q - x), the smallest over the largest LDL^T pivot
-    of J^T J (its conditioning), and the largest component of the pose error at q."""
+    """One Gauss-Newton step on the exact chain from q (5), sn and cs the sines and cosines of
+    q + phi (``_offsets``): the step x (5; the new angles are q - x), the smallest over the
+    largest LDL^T pivot of J^T J (its conditioning), and the largest component of the pose
+    error at q."""
     o0, o1, o2, o3, o4, p = _fk_axes(ch, sn, cs)
     j0, j1, j2 = _column(o0, p), _column(o1, p), _column(o2, p)
     j3, j4 = _column(o3, p), _column(o4, p)
@@ -1023,6 +1024,16 @@ def _polish_settle_all_parallel(m: int, pr: Floats, ch: Floats, c: np.ndarray) -
     _polish_settle_all_of(m, pr, ch, c, True)
 
 
+@numba.njit(cache=True, nogil=True)
+def _polish_settle(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel: bool) -> None:
+    """``_polish_settle_all_parallel`` where the pitch axes are parallel, else
+    ``_polish_settle_all`` (one compiled loop each)."""
+    if parallel:
+        _polish_settle_all_parallel(m, pr, ch, c)
+    else:
+        _polish_settle_all(m, pr, ch, c)
+
+
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
 def _polish_settle_all_of(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel: bool) -> None:
     """The polish (``_polish``) of the m candidates in the rows c (flat: row k is c[k * _CW:];
@@ -1089,10 +1100,7 @@ def _repolish(
             c2[row, j] = c[row, k]
         for row in range(5):  # the sines and cosines where the first polish stopped
             c2[_C_SIN + row, j], c2[_C_COS + row, j] = sincos(c2[_C_Q + row, j])
-    if parallel:
-        _polish_settle_all_parallel(lanes, pr, ch, c2_flat)
-    else:
-        _polish_settle_all(lanes, pr, ch, c2_flat)
+    _polish_settle(lanes, pr, ch, c2_flat, parallel)
     for j in range(count):
         if c2[_C_TAKE, j] == 0.0:
             continue
@@ -1132,7 +1140,7 @@ def _clear_slots(
 @numba.njit(cache=True, nogil=True)
 def _chain_tuple(placements: np.ndarray, axes: np.ndarray) -> Floats:
     """The chain in frames that make each link between two joints sparse, as one tuple: the
-    base block G_1 (3 x 4, row-major), four links (6 each, ``_joint_turned``), the tool block
+    base block N_1 (3 x 4, row-major, below), four links (6 each, ``_joint_turned``), the tool block
     (3 x 4); placements (6, 4, 4), axes (5, 3).
 
     T(q) = M_1 R(u_1, q_1) M_2 ... R(u_5, q_5) M_tool with G_i = [A_i | lambda_i u_i] a frame on
@@ -1347,10 +1355,8 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                 c[k, lane] = c[k, 0]
         if exact:
             _settle_all(lanes, pr, ch, c_flat)
-        elif parallel:
-            _polish_settle_all_parallel(lanes, pr, ch, c_flat)
         else:
-            _polish_settle_all(lanes, pr, ch, c_flat)
+            _polish_settle(lanes, pr, ch, c_flat, parallel)
         for i in range(BLOCK):  # the lanes of no candidate (no flip, past m): nothing to finish
             if i >= m or owned[i] == 0:
                 c[_C_FALL, i] = c[_C_FALL, BLOCK + i] = 0.0
