@@ -204,15 +204,23 @@ class Client(Transport):
         """Content of one artifact."""
         return bytes(self._request("GET", f"/runs/{run_id}/artifacts/{name}").content)
 
-    def download(self, result: RunResult, out_dir: str | Path) -> list[Path]:
-        """Write every artifact of a run into ``out_dir``; their paths."""
-        paths = []
-        for name in result.artifacts:
-            path = Path(out_dir) / name
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_bytes(self.artifact(result.id, name))
-            paths.append(path)
-        return paths
+    def download(
+        self, result: RunResult, out_dir: str | Path, *, force: bool = False
+    ) -> list[Path]:
+        """Write every artifact of a run into ``out_dir`` as a local run would (all together,
+        never touching a file lynxplan did not write, see :mod:`lynxplan.scenarios.folders`);
+        their paths."""
+        from lynxplan.scenarios.folders import staged_outputs
+
+        names = [str(name) for name in result.artifacts]
+        for name in names:
+            if Path(name).is_absolute() or ".." in Path(name).parts:
+                raise LynxplanError(f"run {result.id}: artifact name {name!r} leaves the folder")
+        with staged_outputs(out_dir, force=force) as staging:
+            for name in names:
+                (staging / name).parent.mkdir(parents=True, exist_ok=True)
+                (staging / name).write_bytes(self.artifact(result.id, name))
+        return [Path(out_dir) / name for name in names]
 
     def run(
         self,
@@ -221,18 +229,22 @@ class Client(Transport):
         wait: bool = True,
         quick: bool = False,
         out_dir: str | Path | None = None,
+        force: bool = False,
     ) -> RunResult:
-        """Run a scenario on the server; with ``out_dir``, its artifacts are downloaded there."""
+        """Run a scenario on the server; with ``out_dir``, its artifacts are downloaded there
+        (``force``: as ``lynxplan run --force``)."""
         run_id = self.submit(scenario, quick=quick)
         if not wait:
             return self.status(run_id)
         result = self.wait(run_id)
         if out_dir is not None and result.state == "succeeded":
-            self.download(result, out_dir)
+            self.download(result, out_dir, force=force)
         return result
 
 
-def run_remote(url: str, scenario: str | Path, out_dir: str | Path, *, quick: bool = False) -> int:
+def run_remote(
+    url: str, scenario: str | Path, out_dir: str | Path, *, quick: bool = False, force: bool = False
+) -> int:
     """``lynxplan run --server URL``: run remotely, download the outputs, print the summary.
 
     The token comes from ``LYNXPLAN_TOKEN``. Returns the exit code (0 ok, 1 expectations failed).
@@ -240,7 +252,7 @@ def run_remote(url: str, scenario: str | Path, out_dir: str | Path, *, quick: bo
     import os
 
     with Client(url, token=os.environ.get("LYNXPLAN_TOKEN") or None) as client:
-        result = client.run(scenario, quick=quick, out_dir=out_dir)
+        result = client.run(scenario, quick=quick, out_dir=out_dir, force=force)
     if result.state != "succeeded":
         raise LynxplanError(f"scenario {scenario}: run {result.id} {result.state}: {result.error}")
     print(result.summary)

@@ -48,7 +48,11 @@ def register(subparsers: Any) -> None:
     ws.add_argument("--alpha", required=True, help="platform orientation [deg]")
     ws.add_argument("--step", default="1", help="grid step [mm] (default 1)")
     ws.add_argument("--mode", default=None, help="restrict to a working mode (label or 1..8)")
-    ws.add_argument("--out", default="out", help="folder for the PNG (default: ./out)")
+    ws.add_argument(
+        "--out",
+        default="out/parallel_workspace",
+        help="folder for the PNG (default: out/parallel_workspace)",
+    )
     ws.add_argument("--json", action="store_true", help="print JSON")
     ws.set_defaults(handler=handle_workspace)
 

@@ -11,20 +11,25 @@ def register(subparsers: Any) -> None:
     parser = subparsers.add_parser(
         "run",
         help="run a scenario YAML file",
-        description="Run a scenario and write report.json and its artifacts into --out. The "
-        "folder is replaced as a whole when the run completes (an interrupted or failed run "
-        "leaves the previous one intact). Exit 0: every expectation holds; 1: an expectation "
-        "failed (the report is still written); 2: bad input.",
+        description="Run a scenario and write report.json and its artifacts into --out "
+        "(default: out/<scenario name>). lynxplan's previous outputs there are replaced as a "
+        "whole when the run completes (an interrupted, killed or failed run leaves them intact); "
+        "files lynxplan did not write are never deleted or overwritten: a folder holding some is "
+        "refused unless --force, which keeps them. Exit 0: every expectation holds; 1: an "
+        "expectation failed (the report is still written); 2: bad input.",
     )
     parser.add_argument("scenario", help="scenario YAML file")
-    parser.add_argument("--out", default="out", help="output folder (default: ./out)")
+    parser.add_argument(
+        "--out", help="output folder (default: out/<scenario name>, e.g. out/ok_task)"
+    )
     parser.add_argument(
         "--quick", action="store_true", help="skip plots, HTML and the ruckig/toppra comparisons"
     )
     parser.add_argument(
         "--force",
         action="store_true",
-        help="replace --out even if it holds files lynxplan did not write",
+        help="use --out even if it holds files lynxplan did not write (they stay untouched; "
+        "only lynxplan's own outputs are replaced)",
     )
     parser.add_argument("--server", help="run on a lynxplan server (URL) instead of locally")
     parser.set_defaults(handler=handle)
@@ -32,18 +37,27 @@ def register(subparsers: Any) -> None:
 
 def handle(args: argparse.Namespace) -> int:
     """Run the scenario; exit 0 when every expectation holds, 1 otherwise."""
+    from lynxplan.scenarios.folders import folder_name
+    from lynxplan.scenarios.source import read_source
+
     if args.server:
         from lynxplan.client import run_remote
 
-        return run_remote(args.server, args.scenario, args.out, quick=args.quick)
-    from lynxplan.scenarios import run_scenario
+        out = (
+            args.out
+            or f"out/{folder_name(read_source(args.scenario).data.get('name'), args.scenario)}"
+        )
+        return run_remote(args.server, args.scenario, out, quick=args.quick, force=args.force)
+    from lynxplan.scenarios.runner import execute, load_scenario
 
-    result = run_scenario(args.scenario, args.out, quick=args.quick, force=args.force)
+    loaded = load_scenario(args.scenario)
+    out = args.out or f"out/{folder_name(loaded.scenario.name, args.scenario)}"
+    result = execute(loaded, out, quick=args.quick, force=args.force)
     print(result.summary)
     held = sum(e.passed for e in result.expectations)
     if result.expectations:
         print(f"expectations: {held} of {len(result.expectations)} hold")
-    print(f"outputs in {args.out}/: {', '.join(result.artifacts)}")
+    print(f"outputs in {out}/: {', '.join(result.artifacts)}")
     if not result.ok:
         print("failed expectations:")
         for failure in result.failed_expectations:

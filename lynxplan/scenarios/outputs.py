@@ -1,132 +1,31 @@
-"""Output folders written all together or not at all, and the trajectory CSV.
+"""A run's output folder and the trajectory CSV.
 
-A run writes into a staging folder next to the output folder (``.NAME.staging-PID-XXXX``); only
-when everything is written is the staging folder renamed into place, replacing the previous
-output folder as a whole. So a failed, interrupted or killed run leaves the previous complete
-output untouched, and a ``--quick`` run never leaves an earlier run's plots beside its report.
-
-A folder lynxplan wrote carries a marker file (:data:`MARKER`); a non-empty folder without it holds
-someone else's files and is only replaced with ``force=True``. Staging folders of runs whose
-process no longer exists are removed on the next run.
+The folder (written all together or not at all, never losing a file lynxplan did not write) is
+:mod:`lynxplan.scenarios.folders`; its names are re-exported here.
 """
 
 from __future__ import annotations
 
 import contextlib
-import os
-import shutil
-import tempfile
-from collections.abc import Iterator, Sequence
-from contextlib import contextmanager
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from lynxplan.exceptions import LynxplanError, ShapeError
+from lynxplan.exceptions import ShapeError
+from lynxplan.scenarios.folders import MARKER, OutputFolderError, clean_stale, staged_outputs
 
-#: Marker file in every output folder lynxplan writes.
-MARKER = ".lynxplan-output"
-
-
-class OutputFolderError(LynxplanError):
-    """The output folder cannot be used (not creatable, or holding files lynxplan did not write).
-
-    Attributes:
-        path: The output folder.
-    """
-
-    def __init__(self, path: Path, reason: str) -> None:
-        self.path = path
-        super().__init__(f"output folder {path}: {reason}")
-
-
-def _pid_alive(pid: int) -> bool:
-    try:
-        os.kill(pid, 0)
-    except ProcessLookupError:
-        return False
-    except PermissionError:
-        return True
-    return True
-
-
-def clean_stale(out: Path) -> None:
-    """Remove staging folders of dead runs next to ``out``; restore a displaced previous output.
-
-    A run killed between moving the old folder aside and moving the new one in leaves the old
-    one as ``.NAME.previous-PID-*``: it is moved back when ``out`` is missing.
-    """
-    parent = out.parent
-    if not parent.is_dir():
-        return
-    for kind in ("staging", "previous"):
-        for leftover in sorted(parent.glob(f".{out.name}.{kind}-*")):
-            rest = leftover.name[len(f".{out.name}.{kind}-") :]
-            try:
-                pid = int(rest.split("-")[0])
-            except ValueError:
-                continue
-            if _pid_alive(pid) and pid != os.getpid():
-                continue
-            if kind == "previous" and not out.exists():
-                os.replace(leftover, out)
-            else:
-                shutil.rmtree(leftover, ignore_errors=True)
-
-
-def _check_ownership(out: Path, force: bool) -> None:
-    if not out.exists():
-        return
-    if not out.is_dir():
-        raise OutputFolderError(out, "exists and is not a folder")
-    if force or (out / MARKER).is_file():
-        return
-    if any(out.iterdir()):
-        raise OutputFolderError(
-            out, "holds files lynxplan did not write; choose another folder or pass --force"
-        )
-
-
-@contextmanager
-def staged_outputs(out_dir: str | Path, *, force: bool = False) -> Iterator[Path]:
-    """A staging folder that replaces ``out_dir`` as a whole if the block succeeds.
-
-    Raises:
-        OutputFolderError: ``out_dir`` cannot be created, or holds foreign files (without force).
-    """
-    out = Path(out_dir)
-    try:
-        out.resolve().parent.mkdir(parents=True, exist_ok=True)
-        clean_stale(out)
-        _check_ownership(out, force)
-        staging = Path(
-            tempfile.mkdtemp(prefix=f".{out.name}.staging-{os.getpid()}-", dir=out.parent)
-        )
-    except OSError as exc:
-        raise OutputFolderError(out, f"cannot be created ({exc.strerror or exc})") from exc
-    try:
-        yield staging
-        (staging / MARKER).write_text("written by lynxplan; replaced as a whole by each run\n")
-        _replace(staging, out)
-    finally:
-        shutil.rmtree(staging, ignore_errors=True)
-
-
-def _replace(staging: Path, out: Path) -> None:
-    """Move ``staging`` to ``out``; the previous ``out`` is removed only after the move."""
-    previous = None
-    if out.exists():
-        previous = Path(f"{out.parent}/.{out.name}.previous-{os.getpid()}-{os.urandom(4).hex()}")
-        os.replace(out, previous)
-    try:
-        os.replace(staging, out)
-    except OSError:
-        if previous is not None:
-            os.replace(previous, out)
-        raise
-    if previous is not None:
-        shutil.rmtree(previous, ignore_errors=True)
+__all__ = [
+    "MARKER",
+    "OutputFolderError",
+    "artifact_names",
+    "clean_stale",
+    "csv_rows",
+    "staged_outputs",
+    "write_samples_csv",
+    "write_trajectory_csv",
+]
 
 
 def write_trajectory_csv(

@@ -131,8 +131,22 @@ def execute(
     quick: bool = False,
     force: bool = False,
 ) -> Result:
-    """Run a loaded scenario; write its outputs (all or nothing) into ``out_dir`` if given."""
+    """Run a loaded scenario; write its outputs (all or nothing) into ``out_dir`` if given.
+
+    The output folder is checked before the computation (a folder holding files lynxplan did not
+    write is refused at once, see :mod:`lynxplan.scenarios.folders`), and the run works in a
+    staging folder next to it from start to end.
+    """
+    if out_dir is None:
+        return _compute(loaded, None, quick=quick)
     from lynxplan.scenarios.outputs import staged_outputs
+
+    with staged_outputs(out_dir, force=force) as staging:
+        return _compute(loaded, staging, quick=quick)
+
+
+def _compute(loaded: LoadedScenario, staging: Path | None, *, quick: bool) -> Result:
+    """Run the scenario; write its outputs and report.json into ``staging`` if given."""
     from lynxplan.scenarios.report import write_json
 
     start = time.perf_counter()
@@ -161,14 +175,13 @@ def execute(
             summary=output.summary,
         )
 
-    if out_dir is None:
+    if staging is None:
         return result(())
     from lynxplan.scenarios.report import result_dict
 
-    with staged_outputs(out_dir, force=force) as staging:
-        written = loaded.kind.write_outputs(loaded.scenario, output, staging, quick=quick)
-        final = result(tuple(sorted({*written, "report.json"})))
-        write_json(staging / "report.json", result_dict(final))
+    written = loaded.kind.write_outputs(loaded.scenario, output, staging, quick=quick)
+    final = result(tuple(sorted({*written, "report.json"})))
+    write_json(staging / "report.json", result_dict(final))
     return final
 
 
@@ -183,9 +196,11 @@ def run_scenario(
 
     Args:
         source: Scenario YAML file, or the scenario as a mapping.
-        out_dir: Output folder (replaced as a whole by a complete run), or None to write nothing.
+        out_dir: Output folder, or None to write nothing. A complete run replaces lynxplan's
+            previous outputs there as a whole; files lynxplan did not write are never touched.
         quick: Skip plots, HTML and the comparisons with peer time laws.
-        force: Replace ``out_dir`` even if it holds files lynxplan did not write.
+        force: Use ``out_dir`` even if it holds files lynxplan did not write (they stay; only
+            lynxplan's own outputs are replaced).
 
     Returns:
         The run's :class:`Result`; ``result.ok`` tells whether every expectation held.

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import json
 import os
+import socket
 import sys
 import textwrap
 from pathlib import Path
@@ -159,23 +160,25 @@ def test_foreign_folders_are_refused_unless_forced(tmp_path, capsys):
     out = tmp_path / "mine"
     out.mkdir()
     (out / "thesis.tex").write_text("precious")
-    with pytest.raises(OutputFolderError, match="holds files lynxplan did not write"):
+    with pytest.raises(OutputFolderError, match=r"holds thesis\.tex, which lynxplan did not write"):
         run_scenario(SCENARIOS / "parallel_ik.yaml", out, quick=True)
     assert main(["run", str(SCENARIOS / "parallel_ik.yaml"), "--out", str(out), "--quick"]) == 2
     assert "--force" in capsys.readouterr().err
     assert (out / "thesis.tex").read_text() == "precious"
     run_scenario(SCENARIOS / "parallel_ik.yaml", out, quick=True, force=True)
-    assert (out / "report.json").is_file() and not (out / "thesis.tex").exists()
+    assert (out / "report.json").is_file() and (out / "thesis.tex").read_text() == "precious"
 
 
 def test_stale_staging_of_dead_runs_is_cleaned_and_a_displaced_output_restored(tmp_path):
     out = tmp_path / "out"
     run_scenario(SCENARIOS / "parallel_ik.yaml", out, quick=True)
     dead = 2**22 + 12345  # above pid_max on Linux: no such process
-    stale = tmp_path / f".out.staging-{dead}-abcd"
+    stale = tmp_path / f".out.staging-{dead}-abcd0123"
     stale.mkdir()
     (stale / "half.png").write_text("partial")
-    os.replace(out, tmp_path / f".out.previous-{dead}-ef01")  # killed between the two renames
+    identity = {"pid": dead, "host": socket.gethostname(), "state": "staging"}
+    (stale / MARKER).write_text(json.dumps(identity))
+    os.replace(out, tmp_path / f".out.previous-{dead}-ef012345")  # killed between the renames
     run_scenario(SCENARIOS / "parallel_ik.yaml", out, quick=True)
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out"]
 
