@@ -36,8 +36,27 @@ def handle_schema(args: argparse.Namespace) -> int:
     else:
         module = kind_module(args.kind, "<command line>")
         document = module.Input.model_json_schema(by_alias=True)
+        _list_metrics(document, module.Input.metrics)
     sys.stdout.write(json.dumps(document, indent=2) + "\n")
     return 0
+
+
+def _list_metrics(document: dict[str, Any], metrics: Any) -> None:
+    """Name every metric an ``expect:`` entry may check under ``properties.expect.properties``.
+
+    Each metric also accepts a ``max_``/``min_`` prefix, so ``expect`` stays open to other keys;
+    the runner rejects an unknown name with the list of valid ones.
+    """
+    expect = document.setdefault("properties", {}).setdefault("expect", {})
+    expect["properties"] = {
+        name: {
+            "description": f"{quantity} metric"
+            + ("" if quantity in ("bool", "flags") else f" (also as max_{name} / min_{name})")
+        }
+        for name, quantity in sorted(metrics.items())
+    }
+    names = ", ".join(sorted(metrics))
+    expect["description"] = f"{expect.get('description', '')} Metrics: {names}.".strip()
 
 
 def handle_validate(args: argparse.Namespace) -> int:

@@ -187,3 +187,15 @@ def test_schema_report_command_prints_the_published_schema(capsys):
     assert main(["schema", "report"]) == 0
     schema = json.loads(capsys.readouterr().out)
     assert set(schema["required"]) >= {"kind", "schema_version", "inputs", "metrics", "artifacts"}
+
+
+@pytest.mark.parametrize("kind", ["task", "plan", "trajectory", "workspace"])
+def test_schema_command_lists_the_metrics_expect_may_name(capsys, kind):
+    from lynxplan.scenarios.registry import kind_module
+
+    assert main(["schema", kind]) == 0
+    expect = json.loads(capsys.readouterr().out)["properties"]["expect"]
+    metrics = kind_module(kind, "<test>").Input.metrics
+    assert set(expect["properties"]) == set(metrics)
+    for name in metrics:
+        assert name in expect["description"]
