@@ -9,7 +9,6 @@ import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from importlib import resources
 from pathlib import Path
 from typing import Any
 
@@ -25,10 +24,9 @@ _STRUCTURE_TOLERANCE = 1e-9
 
 def default_urdf_path() -> Path:
     """Path of the shipped AL5 URDF (package data when installed, ``urdf/`` in a checkout)."""
-    packaged = resources.files("lynxplan") / "_data" / "urdf" / DEFAULT_URDF_NAME
-    if packaged.is_file():
-        return Path(str(packaged))
-    return Path(__file__).resolve().parents[2] / "urdf" / DEFAULT_URDF_NAME
+    from lynxplan.shipped import shipped_path
+
+    return shipped_path("urdf", DEFAULT_URDF_NAME)
 
 
 @contextmanager

@@ -22,13 +22,12 @@ import time
 from pathlib import Path
 
 from lynxplan.bench import Figure
+from lynxplan.shipped import checkout_root, scenario_path
 
 SECTION = "cold"
 #: The issue's goals, in [s] of wall time on the CI machine.
 TARGET_FK_SECONDS = 0.5
 TARGET_RUN_SECONDS = 1.5
-_SOURCE_ROOT = Path(__file__).resolve().parents[2]  # the folder holding this lynxplan package
-_SCENARIO = _SOURCE_ROOT / "scenarios" / "ok_task.yaml"
 _CLI = "import sys; from lynxplan.cli import main; sys.exit(main())"
 
 
@@ -40,7 +39,8 @@ def _commands(out_dir: str) -> dict[str, list[str]]:
             python, "-c", _CLI, "fk", "0.1", "0.2", "0.3", "0.4", "0.5",
         ],
         "lynxplan run scenarios/ok_task.yaml --quick": [
-            python, "-c", _CLI, "run", str(_SCENARIO), "--quick", "--out", out_dir, "--force",
+            python, "-c", _CLI, "run", str(scenario_path("ok_task.yaml")), "--quick", "--out",
+            out_dir, "--force",
         ],
     }  # fmt: skip
 
@@ -52,12 +52,11 @@ def time_command(command: list[str]) -> tuple[float, float]:
         RuntimeError: the command failed (its last stderr line is quoted).
     """
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
-    if (_SOURCE_ROOT / "pyproject.toml").is_file():
+    source = checkout_root()
+    if source is not None:
         # Run from a source tree (a checkout, a worktree): the children import this lynxplan,
         # not whichever one their working directory or an editable install would give them.
-        env["PYTHONPATH"] = os.pathsep.join(
-            filter(None, [str(_SOURCE_ROOT), env.get("PYTHONPATH")])
-        )
+        env["PYTHONPATH"] = os.pathsep.join(filter(None, [str(source), env.get("PYTHONPATH")]))
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     done = subprocess.run(command, capture_output=True, text=True, check=False, env=env)

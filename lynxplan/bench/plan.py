@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from lynxplan.bench import Figure
+from lynxplan.shipped import scenario_path
 
 #: Edge resolution of the peers, in [rad] (the issue's clean-path resolution).
 PEER_RESOLUTION = 0.005
@@ -38,7 +39,6 @@ PEER_RESOLUTION = 0.005
 PEER_TIME_LIMIT = 2.0
 #: Issue goals: median and p95 planning time of lynxplan, in [s]; speed-up over OMPL.
 TARGET_MEDIAN, TARGET_P95, TARGET_SPEEDUP = 1e-3, 10e-3, 50.0
-SUITE_DIR = Path(__file__).resolve().parents[2] / "scenarios" / "planning"
 PEERS = {"ompl": "ompl_rrtconnect.py", "pyroboplan": "pyroboplan_rrt.py"}
 
 
@@ -49,7 +49,7 @@ def _suite() -> list[tuple[str, Any]]:
     from lynxplan.scenarios.plan import plan_inputs
 
     problems = []
-    for path in sorted(SUITE_DIR.glob("*.yaml")):
+    for path in sorted(scenario_path("planning").glob("*.yaml")):
         scenario: Any = load_scenario(path).scenario
         robot = scenario.robot
         if robot.urdf is not None or robot.name not in (None, "al5"):

@@ -24,6 +24,7 @@ from typing import Any
 import numpy as np
 
 from lynxplan.bench import Figure
+from lynxplan.shipped import scenario_path
 
 SECTION = "serve"
 CONNECTIONS = 32
@@ -232,7 +233,7 @@ def run(quick: bool) -> list[Figure]:
                 for _ in range(3 if quick else 7):
                     for verify, times in server_ms.items():
                         times.append(_batch_server_ms(client, poses, verify))
-            scenario = Path(__file__).resolve().parents[2] / "scenarios" / "ok_task.yaml"
+            scenario = scenario_path("ok_task.yaml")
             with Client(service_url) as remote:
                 remote.run(scenario, quick=True)  # warm the worker
                 start = time.perf_counter()

@@ -10,14 +10,13 @@ Python/numpy with Pinocchio's FK, Jacobian and Jacobian time variation
 from __future__ import annotations
 
 from functools import partial
-from pathlib import Path
 from typing import cast
 
 from lynxplan.bench import Figure, median_seconds
+from lynxplan.shipped import scenario_path
 
 #: The issue's target for one resolved-rate step, in [us].
 TARGET_US_PER_STEP = 30.0
-_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "singularity_line.yaml"
 
 
 def run(quick: bool) -> list[Figure]:
@@ -32,7 +31,7 @@ def run(quick: bool) -> list[Figure]:
         run_resolved_rate,
     )
 
-    scenario = load_scenario(_SCENARIO).scenario
+    scenario = load_scenario(scenario_path("singularity_line.yaml")).scenario
     problem = build_problem(cast(Scenario, scenario))
     arm = load_arm()
     steps = 10_000

@@ -14,14 +14,15 @@ from pathlib import Path
 from typing import Any
 
 from lynxplan.bench import Figure, median_seconds
+from lynxplan.shipped import scenario_path
 
 #: Target of the issue for the whole run without HTML/plots, in [s].
 TARGET_SECONDS = 3.0
 
 
 def ok_task_path() -> Path:
-    """The shipped scenarios/ok_task.yaml (source checkout)."""
-    return Path(__file__).resolve().parents[2] / "scenarios" / "ok_task.yaml"
+    """The shipped scenarios/ok_task.yaml (package data, or the checkout's file)."""
+    return scenario_path("ok_task.yaml")
 
 
 def run(quick: bool) -> list[Figure]:

@@ -17,9 +17,10 @@ from pathlib import Path
 from typing import Any
 
 from lynxplan.service.execute import execute_run, execute_run_packed
+from lynxplan.shipped import scenario_path
 
 #: Scenario each worker runs once before it reports ready (the OK task: the service's benchmark).
-WARM_UP_SCENARIO = Path(__file__).resolve().parents[2] / "scenarios" / "ok_task.yaml"
+WARM_UP_SCENARIO = scenario_path("ok_task.yaml")
 
 
 def _worker_main(connection: Any, memory_limit: int) -> None:
