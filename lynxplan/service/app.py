@@ -16,7 +16,7 @@ from starlette.types import ASGIApp
 
 from lynxplan import __version__
 from lynxplan.service import compute, wire
-from lynxplan.service.auth import TokenMiddleware
+from lynxplan.service.auth import Guard
 from lynxplan.service.config import ServiceConfig
 from lynxplan.service.fastpath import FastPath
 from lynxplan.service.jobs import RunManager
@@ -32,9 +32,9 @@ FAST_PATHS = ("/ik", "/fk", "/check", "/trajectory")
 
 
 def create_app(config: ServiceConfig) -> ASGIApp:
-    """The ASGI application: the token check (when configured) in front of the hot routes' fast
-    path (:mod:`.fastpath`) in front of the FastAPI app; its run manager starts with the
-    lifespan."""
+    """The ASGI application: the host, origin, token and content-type checks (:mod:`.auth`) in
+    front of the hot routes' fast path (:mod:`.fastpath`) in front of the FastAPI app; its run
+    manager starts with the lifespan."""
     state: dict[str, RunManager] = {}
 
     @asynccontextmanager
@@ -107,8 +107,7 @@ def create_app(config: ServiceConfig) -> ASGIApp:
         media = mimetypes.guess_type(name)[0] or "application/octet-stream"
         return Response(_static(name), media_type=media)
 
-    front = FastPath(app, FAST_PATHS)
-    return TokenMiddleware(front, config.token) if config.token else front
+    return Guard(FastPath(app, FAST_PATHS), config)
 
 
 def _static(name: str) -> bytes:

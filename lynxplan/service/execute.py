@@ -59,28 +59,40 @@ def execute_run_packed(source: str, quick: bool) -> dict[str, Any]:
         return answer
 
 
-def validate_scenario(source: str) -> tuple[str, str]:
+def validate_scenario(source: str, uploaded: bool = False) -> tuple[str, str]:
     """Validate scenario text (YAML or JSON) without running it; its (kind, name).
 
-    A scenario sent over the network may not name files on the server: a ``robot.urdf`` path
-    is refused (built-in robot names only).
+    A scenario sent over the network may not name files on the server: ``robot.name`` must be
+    a built-in robot (never taken for a path), and ``robot.urdf`` is refused unless the URDF was
+    uploaded with it (``uploaded``: the server wrote that path into its run's folder).
 
     Raises:
         lynxplan.exceptions.ScenarioError: naming the key path and the reason.
     """
     from lynxplan.exceptions import ScenarioError
     from lynxplan.scenarios import load_scenario
+    from lynxplan.service.robots import robot_names
 
     with tempfile.TemporaryDirectory(prefix="lynxplan-check-") as folder:
         path = Path(folder) / "scenario.yaml"
         path.write_text(source, encoding="utf-8")
         scenario = load_scenario(path).scenario
-    if getattr(getattr(scenario, "robot", None), "urdf", None) is not None:
+    robot = getattr(scenario, "robot", None)
+    name = getattr(robot, "name", None)
+    if name is not None and name not in robot_names():
+        shown = name if len(name) <= 40 else name[:40] + "..."
+        raise ScenarioError(
+            "<request>",
+            "robot.name",
+            f"unknown robot {shown!r}; robots: {', '.join(robot_names())} "
+            "(or upload a URDF with the run: robot: {urdf: NAME} and files)",
+        )
+    if getattr(robot, "urdf", None) is not None and not uploaded:
         raise ScenarioError(
             "<request>",
             "robot.urdf",
-            "the service runs built-in robots only "
-            "(robot: {name: ...}); it does not read URDF paths on its disk",
+            "the service reads no URDF paths on its disk: upload the URDF and its meshes with "
+            'the run ({"scenario": ..., "files": {NAME: base64}}) or name a built-in robot',
         )
     return str(getattr(scenario, "kind", "")), str(getattr(scenario, "name", "") or "")
 

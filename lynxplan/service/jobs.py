@@ -4,11 +4,13 @@ Layout of the data dir::
 
     lynxplan.sqlite3          one row per run (state, inputs, report, artifacts, timings)
     runs/<id>/scenario.yaml   the scenario as submitted (YAML or JSON text)
+    runs/<id>/files/          the URDF and meshes uploaded with it (:mod:`.uploads`), if any
     runs/<id>/out/            its artifacts (written atomically by the runner's staging folder)
 
 The store is :mod:`.store`, one run's execution :mod:`.execute`, the worker pools :mod:`.pools`.
 On start, runs left ``queued`` or ``running`` by a previous server process are marked
-``interrupted``; finished runs keep their report and artifacts.
+``interrupted``; finished runs keep their report and artifacts. Texts a run reports (its error,
+summary, failed expectations) never show the server's paths: the run's folder reads as ``.``.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ class RunManager:
         memory_limit: int = DEFAULT_RUN_MEMORY,
         dask_scheduler: str | None = None,
     ) -> None:
-        self.data_dir = Path(data_dir)
+        self.data_dir = Path(data_dir).absolute()
         (self.data_dir / "runs").mkdir(parents=True, exist_ok=True)
         self.store = JobStore(self.data_dir / "lynxplan.sqlite3")
         self.interrupted = self.store.mark_interrupted()
@@ -60,13 +62,30 @@ class RunManager:
         """Folder of one run."""
         return self.data_dir / "runs" / run_id
 
-    def submit(self, source: str, kind: str, name: str, quick: bool) -> RunRecord:
-        """Store and queue a validated scenario; the new record (state ``queued``)."""
+    def new_run(self) -> tuple[str, Path]:
+        """A new run id and its (created) folder, for the files uploaded with the run."""
         run_id = uuid.uuid4().hex
         folder = self.run_dir(run_id)
         folder.mkdir(parents=True)
+        return run_id, folder
+
+    def submit(
+        self,
+        source: str,
+        kind: str,
+        name: str,
+        quick: bool,
+        owner: str = "",
+        run_id: str | None = None,
+    ) -> RunRecord:
+        """Store and queue a validated scenario (into the folder of :meth:`new_run` when
+        ``run_id`` is given); the new record (state ``queued``)."""
+        if run_id is None:
+            run_id, folder = self.new_run()
+        else:
+            folder = self.run_dir(run_id)
         (folder / "scenario.yaml").write_text(source, encoding="utf-8")
-        record = RunRecord(run_id, "queued", kind, name, quick, time.time())
+        record = RunRecord(run_id, "queued", kind, name, quick, time.time(), owner=owner)
         self.store.insert(record)
         job = Job(run_id, folder / "scenario.yaml", folder / "out", quick, source)
         with self._lock:
@@ -112,17 +131,31 @@ class RunManager:
                 ("queued", "running"),
                 state="failed",
                 finished=now,
-                error=answer["error"],
+                error=self._public(job, answer["error"]),
                 timings=timings,
             )
             return
         timings["run"] = answer["seconds"]
         self.store.transition(
             job.run_id, ("queued", "running"), state="succeeded", finished=now,
-            ok=answer["ok"], summary=answer["summary"], report=answer["report"],
-            artifacts=answer["artifacts"], timings=timings,
-            error="; ".join(answer["failures"]) or None,
+            ok=answer["ok"], summary=self._public(job, answer["summary"]),
+            report=answer["report"], artifacts=answer["artifacts"], timings=timings,
+            error=self._public(job, "; ".join(answer["failures"])) or None,
         )  # fmt: skip
+
+    def _public(self, job: Job, text: str) -> str:
+        """``text`` without the server's paths: the run's folder as ``.``, the data dir as
+        ``<data-dir>`` (also as resolved, in case it is reached through a link)."""
+        folder = self.run_dir(job.run_id)
+        for path, shown in (
+            (folder / "files", "."),
+            (folder, "."),
+            (self.data_dir, "<data-dir>"),
+        ):
+            for spelling in sorted({str(path.resolve()), str(path)}, key=len, reverse=True):
+                text = text.replace(spelling + "/", "" if shown == "." else shown + "/")
+                text = text.replace(spelling, shown)
+        return text
 
     def artifact(self, run_id: str, name: str) -> Path | None:
         """Path of an artifact the run listed (never a path outside its folder), or None."""

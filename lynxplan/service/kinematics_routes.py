@@ -16,7 +16,7 @@ from lynxplan.service import compute, inputs, wire
 from lynxplan.service.config import ServiceConfig
 from lynxplan.service.jobs import RunManager
 from lynxplan.service.problems import Problem
-from lynxplan.service.robots import get_robot
+from lynxplan.service.robots import get_robot, is_al5, robot_ik_batch_arrays
 from lynxplan.service.schemas import openapi_body
 
 #: Batches at least this large are solved off the event loop (or on Dask when configured).
@@ -85,11 +85,17 @@ def add_kinematics_routes(
             )
             return wire.json_response(_ik_single_json(result, residual))
         reference = inputs.reference(body, len(T))
-        arrays = await _ik_batch(runs(), config, T, reference, only_approach, verify)
+        scalars: dict[str, Any] = {"count": len(T)}
+        if is_al5(arm):
+            arrays = await _ik_batch(runs(), config, T, reference, only_approach, verify)
+        else:  # SO-100, SO-101: lynxplan.robots (their branch slots named in the answer)
+            arrays, scalars["branch_names"] = await _maybe_threaded(
+                len(T), robot_ik_batch_arrays, arm, T, reference, only_approach
+            )
         if wire.wants_binary(request):
-            response = wire.arrays_response(request, arrays, {"count": len(T)})
+            response = wire.arrays_response(request, arrays, scalars)
         else:
-            response = wire.json_response({"count": len(T), **arrays})
+            response = wire.json_response({**scalars, **arrays})
         # Server time from the first body byte to the encoded answer (RFC Server-Timing).
         response.headers["Server-Timing"] = f"app;dur={1e3 * (time.perf_counter() - start):.3f}"
         return response

@@ -1,50 +1,112 @@
-"""The robots the service knows, by name, and their public description."""
+"""The robots the service knows, by built-in name only, and their public description.
+
+Over HTTP a robot is one of lynxplan's built-in robots (``al5``, ``so100``, ``so101``), named
+in the request; no name is ever taken for a path. A URDF of the caller's comes only with a run
+(:mod:`.uploads`), into that run's own folder. The AL5 is served by ``lynxplan.arm`` (its
+closed-form kernels); the others by ``lynxplan.load_robot``.
+"""
 
 from __future__ import annotations
 
+import functools
 from typing import Any
+
+import numpy as np
 
 from lynxplan.service.problems import Problem
 
-#: Robot name -> family (the closed-form IK family of the AL5: base yaw, three pitches, roll).
-ROBOT_FAMILIES = {"al5": "yaw-pitch3-roll"}
+#: Longest robot name quoted back in an error.
+NAME_ECHO = 40
 
 
-def robot_names() -> list[str]:
-    """Names of the robots the service serves."""
-    return sorted(ROBOT_FAMILIES)
+@functools.cache
+def robot_names() -> tuple[str, ...]:
+    """Names of the robots the service serves (lynxplan's built-ins)."""
+    from lynxplan.robots import builtin_robot_names
+
+    return tuple(sorted(builtin_robot_names()))
 
 
-def get_robot(name: str) -> Any:
-    """The robot model (``lynxplan.arm.Arm``) named ``name``; Problem 404 if unknown."""
-    if name not in ROBOT_FAMILIES:
-        raise Problem(404, f"unknown robot {name!r}; robots: {', '.join(robot_names())}", "robot")
-    from lynxplan.arm.model import load_arm
+def check_robot_name(name: object, field: str = "robot") -> str:
+    """``name`` if it is a built-in robot; else Problem 404 naming ``field`` and the robots
+    (never looked up on the disk: the answer is the same for any other string; 422 for a
+    value that is not a string)."""
+    if not isinstance(name, str):
+        raise Problem(422, f"{field} must be a robot name. Got: {type(name).__name__}", field)
+    if name not in robot_names():
+        shown = name if len(name) <= NAME_ECHO else name[:NAME_ECHO] + "..."
+        raise Problem(
+            404, f"{field}: unknown robot {shown!r}; robots: {', '.join(robot_names())}", field
+        )
+    return name
 
-    return load_arm()
+
+def get_robot(name: str, field: str = "robot") -> Any:
+    """The model of built-in robot ``name``: ``lynxplan.arm.Arm`` for the AL5, else a
+    ``lynxplan.robots.Robot``; Problem 404 if ``name`` is not a built-in."""
+    check_robot_name(name, field)
+    if name == "al5":
+        from lynxplan.arm.model import load_arm
+
+        return load_arm()
+    from lynxplan.robots import load_robot
+
+    return load_robot(name)
+
+
+def is_al5(robot: Any) -> bool:
+    """Whether ``robot`` is the AL5 of ``lynxplan.arm`` (its own IK API)."""
+    from lynxplan.arm.model import Arm
+
+    return isinstance(robot, Arm)
 
 
 def describe_robot(name: str) -> dict[str, Any]:
-    """Joints, limits (rad, rad/s), family, tool frame and DH lengths (m) of robot ``name``."""
-    arm = get_robot(name)
-    from lynxplan.arm.geometry import JOINT_NAMES, TOOL_FRAME
+    """Joints, limits (rad, rad/s), family, tool frame (and the AL5's DH lengths, m) of a
+    built-in robot; Problem 404 if ``name`` is not one."""
+    robot = get_robot(name)
+    limits = robot.limits
+    if is_al5(robot):
+        from lynxplan.arm.geometry import JOINT_NAMES, TOOL_FRAME
 
-    limits = arm.limits
-    return {
+        joints, tool, family = JOINT_NAMES, TOOL_FRAME, "yaw-pitch3-roll"
+    else:
+        joints, tool = robot.joint_names, robot.tool_frame
+        family = "yaw-pitch3-roll" if robot.family is not None else "numerical"
+    described: dict[str, Any] = {
         "name": name,
-        "family": ROBOT_FAMILIES[name],
-        "dof": int(arm.model.nq),
-        "tool": TOOL_FRAME,
-        "urdf": arm.urdf_path.name,
+        "family": family,
+        "dof": int(robot.model.nq),
+        "tool": tool,
+        "urdf": robot.urdf_path.name,
         "joints": [
             {"name": joint, "lower": lower, "upper": upper, "velocity": velocity}
             for joint, lower, upper, velocity in zip(
-                JOINT_NAMES,
+                joints,
                 limits.lower.tolist(),
                 limits.upper.tolist(),
                 limits.velocity.tolist(),
                 strict=True,
             )
         ],
-        "geometry": {"a2": arm.geometry.a2, "a3": arm.geometry.a3, "d5": arm.geometry.d5},
     }
+    if is_al5(robot):
+        described["geometry"] = {"a2": robot.geometry.a2, "a3": robot.geometry.a3,
+                                 "d5": robot.geometry.d5}  # fmt: skip
+    return described
+
+
+def robot_ik_batch_arrays(
+    robot: Any, T: np.ndarray, q_reference: np.ndarray | None, approach_only: bool
+) -> tuple[dict[str, np.ndarray], list[str]]:
+    """All-branch IK of (N, 4, 4) poses for a ``lynxplan.robots.Robot``: the arrays of its
+    ``RobotIkBatch`` (``position_error``: the solver's FK check of each branch, in [m]) and the
+    names of the branch slots. ``approach_only``: column 3 is the point, column 2 the approach."""
+    if approach_only:
+        batch = robot.ik_batch(
+            positions=T[:, :3, 3], approaches=T[:, :3, 2], q_reference=q_reference
+        )
+    else:
+        batch = robot.ik_batch(T, q_reference=q_reference)
+    arrays = {name: np.asarray(getattr(batch, name)) for name in batch._fields[:-1]}
+    return arrays, list(batch.branch_names)

@@ -34,9 +34,12 @@ CREATE TABLE IF NOT EXISTS runs (
     error TEXT,
     report TEXT,
     artifacts TEXT NOT NULL DEFAULT '[]',
-    timings TEXT NOT NULL DEFAULT '{}'
+    timings TEXT NOT NULL DEFAULT '{}',
+    owner TEXT NOT NULL DEFAULT ''
 )
 """
+#: Stores written before run ownership lack the ``owner`` column: added on open.
+_ADD_OWNER = "ALTER TABLE runs ADD COLUMN owner TEXT NOT NULL DEFAULT ''"
 
 
 @dataclass(frozen=True)
@@ -55,6 +58,7 @@ class RunRecord:
         report: The run's ``report.json`` content, if it wrote one.
         artifacts: Relative paths of its output files.
         timings: Durations, in [s]: ``queued``, ``run`` (worker), ``total``.
+        owner: Name of the token that created the run (``""``: no token or one shared token).
     """
 
     id: str
@@ -71,6 +75,7 @@ class RunRecord:
     report: Any = None
     artifacts: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
+    owner: str = ""
 
     def as_json(self) -> dict[str, Any]:
         """The record as a JSON object (``progress`` 0 queued, 0.5 running, 1 final)."""
@@ -94,6 +99,9 @@ class JobStore:
             self._db.execute("PRAGMA journal_mode=WAL")
             self._db.execute("PRAGMA synchronous=NORMAL")
             self._db.execute(_SCHEMA)
+            columns = [row[1] for row in self._db.execute("PRAGMA table_info(runs)")]
+            if "owner" not in columns:
+                self._db.execute(_ADD_OWNER)
 
     def close(self) -> None:
         """Close the database."""
@@ -109,7 +117,8 @@ class JobStore:
         """Store a new run."""
         with self._lock:
             self._db.execute(
-                "INSERT INTO runs (id, state, kind, name, quick, created) VALUES (?,?,?,?,?,?)",
+                "INSERT INTO runs (id, state, kind, name, quick, created, owner) "
+                "VALUES (?,?,?,?,?,?,?)",
                 (
                     record.id,
                     record.state,
@@ -117,6 +126,7 @@ class JobStore:
                     record.name,
                     int(record.quick),
                     record.created,
+                    record.owner,
                 ),
             )
 
@@ -146,14 +156,17 @@ class JobStore:
             row = self._db.execute("SELECT * FROM runs WHERE id = ?", (run_id,)).fetchone()
         return None if row is None else _record(row)
 
-    def page(self, offset: int, limit: int) -> tuple[list[RunRecord], int]:
-        """Runs, newest first, and the total count."""
+    def page(
+        self, offset: int, limit: int, owner: str | None = None
+    ) -> tuple[list[RunRecord], int]:
+        """Runs (of ``owner`` only, unless None), newest first, and their total count."""
+        where, args = ("", ()) if owner is None else ("WHERE owner = ? ", (owner,))
         with self._lock:
             rows = self._db.execute(
-                "SELECT * FROM runs ORDER BY created DESC, rowid DESC LIMIT ? OFFSET ?",
-                (limit, offset),
+                f"SELECT * FROM runs {where}ORDER BY created DESC, rowid DESC LIMIT ? OFFSET ?",
+                (*args, limit, offset),
             ).fetchall()
-            total = int(self._db.execute("SELECT COUNT(*) FROM runs").fetchone()[0])
+            total = int(self._db.execute(f"SELECT COUNT(*) FROM runs {where}", args).fetchone()[0])
         return [_record(row) for row in rows], total
 
     def mark_interrupted(self) -> int:
@@ -174,12 +187,12 @@ def _jsonable(value: Any) -> Any:
 
 def _record(row: tuple[Any, ...]) -> RunRecord:
     (run_id, state, kind, name, quick, created, started, finished, ok, summary, error, report,
-     artifacts, timings) = row  # fmt: skip
+     artifacts, timings, owner) = row  # fmt: skip
     return RunRecord(
         run_id, state, kind, name, bool(quick), created, started, finished,
         None if ok is None else bool(ok), summary, error,
         None if report is None else json.loads(report), tuple(json.loads(artifacts)),
-        json.loads(timings),
+        json.loads(timings), owner,
     )  # fmt: skip
 
 

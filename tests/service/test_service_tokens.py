@@ -60,7 +60,7 @@ def test_missing_or_wrong_token_is_401(guarded: Server, header: str | None) -> N
         ("GET", "/robots"),
         ("POST", "/ik"),
         ("GET", "/runs"),
-        ("GET", "/openapi.json"),
+        ("GET", "/version"),
         ("GET", "/no-such-route"),
     ):
         response = httpx.request(method, guarded.url + path, headers=headers)
@@ -71,6 +71,9 @@ def test_missing_or_wrong_token_is_401(guarded: Server, header: str | None) -> N
 
 def test_health_needs_no_token_and_the_right_token_works(guarded: Server) -> None:
     assert httpx.get(guarded.url + "/health").status_code == 200
+    # The web page, its scripts and the API description hold no data: open, and /docs works.
+    for path in ("/", "/docs", "/openapi.json", "/static/app.js", "/static/docs.js"):
+        assert httpx.get(guarded.url + path).status_code == 200, path
     with Client(guarded.url, token=TOKEN) as client:
         assert client.robots()[0]["name"] == "al5"
     with Client(guarded.url) as client, pytest.raises(ServiceError, match="401"):
