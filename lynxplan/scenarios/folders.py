@@ -46,6 +46,8 @@ from lynxplan.exceptions import LynxplanError
 
 #: The manifest in every output (and staging) folder lynxplan writes.
 MARKER = ".lynxplan-output"
+#: The manifest and the temporary file it is written through: lynxplan's in every folder.
+_MANIFEST_NAMES = (MARKER, f"{MARKER}.partial")
 #: Errors of ``os.link`` that mean the file system has no hard links (then files are moved in).
 _NO_HARD_LINKS = frozenset(
     {errno.EPERM, errno.ENOTSUP, errno.EOPNOTSUPP, errno.EXDEV, errno.EMLINK, errno.ENOSYS}
@@ -148,7 +150,7 @@ def _scan(out: Path) -> _Scan:
         with os.scandir(folder) as entries:
             for entry in sorted(entries, key=lambda e: e.name):
                 rel = prefix + entry.name
-                if rel == MARKER:
+                if rel in _MANIFEST_NAMES:
                     continue
                 if entry.is_dir(follow_symlinks=False):
                     if rel in folders:
@@ -274,7 +276,7 @@ def _discard(old: Path, out: Path, *, force: bool) -> None:
             target = out / rel
             accepted = files.get(rel, [])
             own = rel in files and (force or accepted is None or _digest(path) in accepted)
-            if rel == MARKER or own or _same_file(path, target):
+            if rel in _MANIFEST_NAMES or own or _same_file(path, target):
                 path.unlink()
             elif not os.path.lexists(target):
                 with contextlib.suppress(OSError):
@@ -308,7 +310,7 @@ def _locked(folder: Path) -> Iterator[None]:
 def _write_manifest(folder: Path, content: Mapping[str, Any]) -> None:
     """Write the manifest through a temporary file renamed over it (never half written)."""
     text = json.dumps({"written_by": "lynxplan", **content}, indent=1, sort_keys=True) + "\n"
-    partial = folder / f"{MARKER}.partial"
+    partial = folder / _MANIFEST_NAMES[1]
     partial.write_text(text, encoding="utf-8")
     os.replace(partial, folder / MARKER)
 
@@ -332,7 +334,7 @@ def _written(staging: Path) -> list[str]:
     for root, _, files in os.walk(staging):
         for name in files:
             rel = Path(root, name).relative_to(staging).as_posix()
-            if rel not in (MARKER, f"{MARKER}.partial"):
+            if rel not in _MANIFEST_NAMES:
                 names.append(rel)
     return sorted(names)
 

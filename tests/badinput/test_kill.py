@@ -42,11 +42,12 @@ def _debris(parent: Path, name: str) -> list[str]:
 
 
 def _kill_while_writing(process: subprocess.Popen[str], parent: Path, name: str) -> bool:
-    """SIGKILL ``process`` as soon as its staging folder holds a file; False if it ended first."""
+    """SIGKILL ``process`` as soon as its staging folder holds an output (its manifest, written
+    when the folder is made, does not count); False if it ended first."""
     deadline = time.monotonic() + 120.0
     while time.monotonic() < deadline and process.poll() is None:
         for staging in parent.glob(f".{name}.staging-*"):
-            if any(p.is_file() for p in staging.rglob("*")):
+            if any(p.is_file() and p.name != ".lynxplan-output" for p in staging.rglob("*")):
                 process.send_signal(signal.SIGKILL)
                 process.communicate(timeout=30)
                 return True
@@ -115,8 +116,10 @@ def test_run_into_foreign_folder_needs_force(tmp_path: Path, capsys) -> None:
     (out / "thesis.tex").write_text("do not delete")
     assert main(["run", str(scenario), "--out", str(out), "--quick"]) == 2
     err = capsys.readouterr().err
-    assert err.count("\n") == 1 and "holds files lynxplan did not write" in err and "--force" in err
+    assert err.count("\n") == 1 and "thesis.tex, which lynxplan did not write" in err
+    assert "--force" in err
     assert (out / "thesis.tex").read_text() == "do not delete"
     assert main(["run", str(scenario), "--out", str(out), "--quick", "--force"]) == 0
-    assert not (out / "thesis.tex").exists() and (out / "report.json").is_file()
+    # --force replaces lynxplan's outputs only: the user's file stays.
+    assert (out / "thesis.tex").read_text() == "do not delete" and (out / "report.json").is_file()
     assert _debris(tmp_path, "mine") == []

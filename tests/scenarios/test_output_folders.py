@@ -18,7 +18,7 @@ from pathlib import Path
 
 import pytest
 
-from lynxplan.scenarios.folders import MARKER, folder_name
+from lynxplan.scenarios.folders import MARKER, OutputFolderError, folder_name
 from lynxplan.scenarios.runner import run_scenario
 
 SCENARIOS = Path(__file__).resolve().parents[2] / "scenarios"
@@ -216,3 +216,36 @@ def test_without_hard_links_the_outputs_are_moved_in_file_by_file(tmp_path, monk
 )
 def test_the_default_folder_name(name, path, folder):
     assert folder_name(name, path) == folder
+
+
+def test_a_folder_written_before_the_manifest_is_still_lynxplans(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / MARKER).write_text("written by lynxplan; replaced as a whole by each run\n")
+    (out / "report.json").write_text(json.dumps({"artifacts": ["parallel_ik.json", "report.json"]}))
+    (out / "parallel_ik.json").write_text("{}")
+    (out / "notes.txt").write_text("mine")
+    with pytest.raises(OutputFolderError, match=r"holds notes\.txt"):
+        run_scenario(PARALLEL_IK, out, quick=True)
+    (out / "notes.txt").unlink()
+    run_scenario(PARALLEL_IK, out, quick=True)  # its report's artifacts are lynxplan's
+    assert json.loads((out / MARKER).read_text())["files"].keys() == {
+        "parallel_ik.json",
+        "report.json",
+    }
+
+
+def test_forced_runs_keep_foreign_links_and_folders_as_they_are(tmp_path):
+    out = tmp_path / "out"
+    out.mkdir()
+    (tmp_path / "data.csv").write_text("1\n")
+    (out / "data.csv").symlink_to(tmp_path / "data.csv")
+    (out / "raw").mkdir()
+    (out / "raw" / "log.txt").write_text("log")
+    inode = (out / "raw" / "log.txt").stat().st_ino
+    run_scenario(PARALLEL_IK, out, quick=True, force=True)
+    run_scenario(PARALLEL_IK, out, quick=True)
+    assert os.readlink(out / "data.csv") == str(tmp_path / "data.csv")
+    assert (out / "raw" / "log.txt").stat().st_ino == inode  # the same file, not a copy
+    assert (tmp_path / "data.csv").read_text() == "1\n"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["data.csv", "out"]
