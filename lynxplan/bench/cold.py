@@ -35,8 +35,8 @@ def _commands(out_dir: str) -> dict[str, list[str]]:
     python = sys.executable
     return {
         "python -c 'import pinocchio'": [python, "-c", "import pinocchio"],
-        "lynxplan fk 0.1 0.2 0.3 0.4 0.5": [
-            python, "-c", _CLI, "fk", "0.1", "0.2", "0.3", "0.4", "0.5",
+        "lynxplan fk 0.1 0.2 -0.3 0.4 0.5": [
+            python, "-c", _CLI, "fk", "0.1", "0.2", "-0.3", "0.4", "0.5",
         ],
         "lynxplan run scenarios/ok_task.yaml --quick": [
             python, "-c", _CLI, "run", str(scenario_path("ok_task.yaml")), "--quick", "--out",

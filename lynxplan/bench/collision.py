@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from lynxplan.bench import Figure, median_seconds
+from lynxplan.bench import Figure, median_seconds, peer_missing
 
 RATE = 1000.0
 NAIVE_SAMPLES = 2000
@@ -100,7 +100,8 @@ def run(quick: bool) -> list[Figure]:
     build = median_seconds(lambda: CollisionWorld(arm, walls), repeats=repeats)
     figures.append(Figure("collision", "world build (once per check)", build * 1e3, "ms"))
     if "fcl" not in engines:
-        return figures
+        return [*figures, peer_missing("collision", "python-fcl (naive loop, fcl engine)",
+                                       "module fcl: pip install python-fcl")]  # fmt: skip
     subset = q[: 500 if quick else NAIVE_SAMPLES]
     naive = (
         median_seconds(lambda: naive_check(arm, walls, subset), repeats=3) * len(q) / len(subset)

@@ -21,16 +21,15 @@ zero clearance (boolean collision checks); lynxplan keeps its required clearance
 from __future__ import annotations
 
 import json
-import os
 import subprocess
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from lynxplan.bench import Figure
+from lynxplan.bench import Figure, not_run, peer_missing
+from lynxplan.bench.peers import peer_python
 from lynxplan.shipped import scenario_path
 
 #: Edge resolution of the peers, in [rad] (the issue's clean-path resolution).
@@ -60,12 +59,6 @@ def _suite() -> list[tuple[str, Any]]:
     return problems
 
 
-def _peer_python(name: str) -> Path | None:
-    root = Path(os.environ.get("LYNXPLAN_PEERS", "/work/peers"))
-    python = root / name / "bin" / "python"
-    return python if python.is_file() else None
-
-
 def _obstacle_json(obstacle: Any) -> dict[str, Any]:
     entry: dict[str, Any] = {
         "name": obstacle.name,
@@ -81,17 +74,19 @@ def _obstacle_json(obstacle: Any) -> dict[str, Any]:
     return entry
 
 
-def _run_peer(name: str, spec: dict[str, Any]) -> list[dict[str, Any]] | None:
-    python = _peer_python(name)
-    if python is None:
-        return None
+def _run_peer(name: str, spec: dict[str, Any]) -> list[dict[str, Any]]:
+    """The peer's results on the problems of ``spec``.
+
+    Raises:
+        RuntimeError: the peer failed (its last stderr line is quoted).
+    """
     import tempfile
 
     script = Path(__file__).parent / "peers" / PEERS[name]
     with tempfile.TemporaryDirectory() as folder:
         output = Path(folder) / "results.json"
         done = subprocess.run(
-            [str(python), str(script), str(output)],
+            [str(peer_python(name)), str(script), str(output)],
             input=json.dumps(spec),
             capture_output=True,
             text=True,
@@ -99,9 +94,8 @@ def _run_peer(name: str, spec: dict[str, Any]) -> list[dict[str, Any]] | None:
             timeout=3600,
         )
         if done.returncode != 0 or not output.is_file():
-            tail = done.stderr.strip().splitlines()[-1:]
-            print(f"peer {name} failed: {tail}", file=sys.stderr)
-            return None
+            tail = (done.stderr.strip().splitlines() or ["no output"])[-1][:200]
+            raise RuntimeError(f"exited {done.returncode}: {tail}")
         result: list[dict[str, Any]] = json.loads(output.read_text(encoding="utf-8"))
     return result
 
@@ -159,7 +153,10 @@ def run(quick: bool) -> list[Figure]:
         "time_limit": PEER_TIME_LIMIT,
     }
     worlds = {}
-    for name, inputs in _suite():
+    suite = _suite()
+    if not suite:
+        raise RuntimeError(f"no solvable AL5 problem in {scenario_path('planning')}")
+    for name, inputs in suite:
         planner = Planner(inputs.robot, inputs.obstacles, inputs.options)
         planner.solve(inputs.start, inputs.goal, seed=0, time_limit=inputs.time_limit)  # JIT
         per_seed = []
@@ -195,11 +192,21 @@ def run(quick: bool) -> list[Figure]:
     figures.append(Figure("plan", "lynxplan: median whole solve() call (start/goal checks, IK "
                           "goals, plan, shortcut, verify, ruckig timing)",
                           float(np.median(calls)) * 1e3, "ms"))  # fmt: skip
+    return figures + _peer_figures(spec, worlds, times)
+
+
+def _peer_figures(spec: dict[str, Any], worlds: dict[str, Any], times: list[float]) -> list[Figure]:
+    """Each peer on the problems of ``spec`` (its paths checked in ``worlds``), against
+    lynxplan's planning ``times``; a peer not installed or failing says so."""
+    figures: list[Figure] = []
     for peer in PEERS:
-        results = _run_peer(peer, {**spec, "simplify": True})
-        if results is None:
-            figures.append(Figure("plan", f"{peer}: not installed (LYNXPLAN_PEERS)", float("nan"),
-                                  ""))  # fmt: skip
+        if not peer_python(peer).is_file():
+            figures.append(peer_missing("plan", peer, peer_python(peer)))
+            continue
+        try:
+            results = _run_peer(peer, {**spec, "simplify": True})
+        except (RuntimeError, subprocess.TimeoutExpired, ValueError) as error:
+            figures.append(not_run("plan", peer, f"peer {peer} failed: {error}"))
             continue
         ok = [r for r in results if r["solved"] and np.ndim(r["path"]) == 2 and len(r["path"]) > 1]
         peer_times = [r["plan_time"] + r["simplify_time"] for r in ok]

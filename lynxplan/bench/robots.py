@@ -12,7 +12,6 @@ Peers with conflicting requirements (placo needs pin 3.8) are not run in-process
 from __future__ import annotations
 
 import json
-import os
 import subprocess
 import tempfile
 import time
@@ -21,7 +20,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lynxplan.bench import Figure, median_seconds
+from lynxplan.bench import Figure, median_seconds, not_run, peer_missing
+from lynxplan.bench.peers import peers_dir
 
 if TYPE_CHECKING:
     from lynxplan.robots import Robot
@@ -93,7 +93,7 @@ def _approach_round_trips(robot: Robot, count: int, seed: int) -> tuple[float, f
 
 #: Peers run in their own virtual environments: PEERS_DIR/<peer>/bin/python (placo, pink, mink,
 #: ikpy; placo 0.10 needs pin 3.8, which conflicts with lynxplan's pin 4).
-PEERS_DIR = os.environ.get("LYNXPLAN_PEERS_DIR", "/work/peers")
+PEERS_DIR = str(peers_dir())
 #: The peers, in the order of the table.
 PEERS = ("placo", "pink", "mink", "ikpy")
 
@@ -167,6 +167,7 @@ def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
         for peer in PEERS:
             python = Path(PEERS_DIR) / peer / "bin" / "python"
             if not python.is_file():
+                figures.append(peer_missing("robots", f"{robot.name} {peer}", python))
                 continue
             out = Path(folder) / f"{peer}.json"
             args = [
@@ -182,9 +183,7 @@ def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
             if done.returncode != 0 or not out.is_file():
                 lines = (done.stderr or done.stdout or "no output").strip().splitlines()
                 reason = lines[-1][:120] if lines else "no output"
-                figures.append(
-                    Figure("robots", f"{robot.name} {peer} did not run: {reason}", np.nan, "")
-                )
+                figures.append(not_run("robots", f"{robot.name} {peer}", f"peer failed: {reason}"))
                 continue
             result = json.loads(out.read_text())
             name = f"{peer} {result['version']}"
