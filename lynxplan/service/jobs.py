@@ -15,6 +15,7 @@ summary, failed expectations) never show the server's paths: the run's folder re
 
 from __future__ import annotations
 
+import json
 import shutil
 import threading
 import time
@@ -136,10 +137,17 @@ class RunManager:
             )
             return
         timings["run"] = answer["seconds"]
+        report = answer["report"]
+        if report is not None and (self.run_dir(job.run_id) / "files").is_dir():
+            # the report echoes robot.urdf: the uploaded URDF's path in the run's folder
+            report = json.loads(self._public(job, json.dumps(report)))
+            report_file = job.out_dir / "report.json"
+            if report_file.is_file():
+                report_file.write_text(self._public(job, report_file.read_text()))
         self.store.transition(
             job.run_id, ("queued", "running"), state="succeeded", finished=now,
             ok=answer["ok"], summary=self._public(job, answer["summary"]),
-            report=answer["report"], artifacts=answer["artifacts"], timings=timings,
+            report=report, artifacts=answer["artifacts"], timings=timings,
             error=self._public(job, "; ".join(answer["failures"])) or None,
         )  # fmt: skip
 
