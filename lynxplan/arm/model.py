@@ -115,16 +115,16 @@ class Arm:
     @cached_property
     def collision_model(self) -> Any:
         """Pinocchio GeometryModel of the URDF's collision elements."""
-        import pinocchio as pin
+        from lynxplan.mesh_paths import urdf_geometry_model
 
-        return pin.buildGeomFromUrdf(self.model, str(self.urdf_path), pin.GeometryType.COLLISION)
+        return urdf_geometry_model(self.model, self.urdf_path, (), "collision")
 
     @cached_property
     def visual_model(self) -> Any:
         """Pinocchio GeometryModel of the URDF's visual elements."""
-        import pinocchio as pin
+        from lynxplan.mesh_paths import urdf_geometry_model
 
-        return pin.buildGeomFromUrdf(self.model, str(self.urdf_path), pin.GeometryType.VISUAL)
+        return urdf_geometry_model(self.model, self.urdf_path, (), "visual")
 
     # -- kinematics -------------------------------------------------------------------------------
     def fk(self, q: np.ndarray) -> np.ndarray:

@@ -57,7 +57,8 @@ class CollisionWorld:
     Args:
         arm: The arm (``lynxplan.arm.Arm``): its Pinocchio model and collision GeometryModel.
         obstacles: The obstacles (boxes, spheres, cylinders), in [m].
-        self_collision: Also check every pair of primitives on non-adjacent links.
+        self_collision: Also check every pair of primitives on non-adjacent links, except the
+            link pairs of the arm's ``disabled_collisions`` (its SRDF's), if it has any.
         engine: Distance engine, ``"coal"`` (exact) or ``"fcl"`` (python-fcl; see above).
 
     Attributes:
@@ -66,6 +67,8 @@ class CollisionWorld:
         pair_link: Primitive index of each checked pair, shape (P,).
         pair_other: Obstacle index (or, for self pairs, primitive index) of each pair, (P,).
         pair_is_self: Whether each pair is a self-collision pair, shape (P,).
+        self_pairs: The primitive pairs (a, b), a < b, a self-collision check covers (see
+            :func:`self_collision_pairs`), checked by this world if ``self_collision``.
     """
 
     def __init__(
@@ -92,14 +95,12 @@ class CollisionWorld:
             link_primitive(self.model, g, self._joint_placements)
             for g in arm.collision_model.geometryObjects
         )
+        self.self_pairs = self_collision_pairs(
+            self.model, self.links, getattr(arm, "disabled_collisions", ())
+        )
         pairs = [(g, o, False) for o in range(len(self.obstacles)) for g in range(len(self.links))]
         if self_collision:
-            parents = list(self.model.parents)
-            for a in range(len(self.links)):
-                for b in range(a + 1, len(self.links)):
-                    ja, jb = self.links[a].joint, self.links[b].joint
-                    if ja != jb and parents[ja] != jb and parents[jb] != ja:
-                        pairs.append((a, b, True))
+            pairs += [(a, b, True) for a, b in self.self_pairs]
         self.pair_link = np.array([p[0] for p in pairs], dtype=np.intp)
         self.pair_other = np.array([p[1] for p in pairs], dtype=np.intp)
         self.pair_is_self = np.array([p[2] for p in pairs], dtype=bool)
@@ -293,6 +294,25 @@ class CollisionWorld:
         return np.asarray(bounds)
 
 
+def self_collision_pairs(
+    model: Any, links: Sequence[LinkPrimitive], disabled: Sequence[tuple[str, str]] = ()
+) -> tuple[tuple[int, int], ...]:
+    """The primitive pairs (a, b), a < b, checked for self-collision: primitives on different,
+    non-adjacent bodies (adjacent ones touch by design), except those whose links form a pair of
+    ``disabled`` (an SRDF's ``disable_collisions``)."""
+    parents = list(model.parents)
+    skip = {frozenset(pair) for pair in disabled}
+    pairs = []
+    for a in range(len(links)):
+        for b in range(a + 1, len(links)):
+            ja, jb = links[a].joint, links[b].joint
+            if ja == jb or parents[ja] == jb or parents[jb] == ja:
+                continue
+            if frozenset((links[a].link, links[b].link)) not in skip:
+                pairs.append((a, b))
+    return tuple(pairs)
+
+
 def reach_products(joint_steps: np.ndarray, reach: np.ndarray) -> np.ndarray:
     """``joint_steps @ reach.T``: per row and primitive, ``sum_j reach[g, j] * joint_steps[n, j]``.
 
@@ -314,4 +334,4 @@ def _configurations(q: Any, nq: int) -> np.ndarray:
     return config
 
 
-__all__ = ["CollisionWorld", "LinkPrimitive", "signed_distance"]
+__all__ = ["CollisionWorld", "LinkPrimitive", "self_collision_pairs", "signed_distance"]

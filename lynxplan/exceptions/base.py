@@ -186,6 +186,22 @@ class ModelError(LynxplanInputError):
     """A robot model (URDF) cannot be loaded or does not have the expected structure."""
 
 
+class MeshNotFoundError(ModelError):
+    """A mesh a URDF names (``<mesh filename=...>``) is not found in any mesh search folder.
+
+    Attributes:
+        mesh: The ``filename`` as the URDF writes it.
+        urdf: Name of the URDF.
+        searched: The folders searched, in order.
+    """
+
+    def __init__(self, mesh: str, urdf: str, searched: tuple[str, ...], hint: str) -> None:
+        self.mesh = mesh
+        self.urdf = urdf
+        self.searched = searched
+        super().__init__(f"URDF {urdf}: mesh {mesh or '(empty filename)'} not found ({hint})")
+
+
 class TaskError(InputError):
     """A singularity task (selection of tool-Jacobian rows) is unknown or unusable.
 

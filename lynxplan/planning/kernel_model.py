@@ -220,14 +220,9 @@ def planner_pairs(world: CollisionWorld) -> tuple[np.ndarray, list[tuple[str, st
             if link.joint != 0:
                 rows.append((g, o, 0))
                 names.append((link.geometry, obstacle.name))
-    parents = list(world.model.parents)
-    for a in range(len(links)):
-        for b in range(a + 1, len(links)):
-            ja, jb = links[a].joint, links[b].joint
-            if ja == jb or parents[ja] == jb or parents[jb] == ja:
-                continue  # same or adjacent bodies: touching by design (URDF adjacency)
-            rows.append((a, b, 1))
-            names.append((links[a].geometry, f"self:{links[b].geometry}"))
+    for a, b in world.self_pairs:  # non-adjacent bodies, less the SRDF's disabled pairs
+        rows.append((a, b, 1))
+        names.append((links[a].geometry, f"self:{links[b].geometry}"))
     return np.array(rows, dtype=np.int64).reshape(-1, 3), names
 
 

@@ -51,6 +51,7 @@ def load_robot(
     tool: str | None = None,
     base: Any = None,
     package_dirs: list[str] | tuple[str, ...] | None = None,
+    srdf: str | Path | None = None,
 ) -> Robot:
     """A robot by built-in name (``al5``, ``so100``, ``so101``) or URDF path.
 
@@ -58,19 +59,24 @@ def load_robot(
         name_or_urdf: Built-in name or path of a URDF file.
         tool: Tool frame name (default: the built-in's tool; for a URDF, its last frame).
         base: Placement of the robot base in the world, shape (4, 4), [m]. Default: identity.
-        package_dirs: Folders ``package://`` mesh URIs resolve against.
+        package_dirs: Folders searched first for ``package://`` and relative mesh paths (then
+            ROS_PACKAGE_PATH, AMENT_PREFIX_PATH, the URDF's folder and its parents and
+            example-robot-data; see :mod:`lynxplan.mesh_paths`).
+        srdf: SRDF whose ``disable_collisions`` pairs are not checked for self-collision.
+            Default: ``<stem>.srdf`` next to the URDF or in ``../srdf/``, if there is one.
 
     Raises:
         UnknownRobotError: neither a built-in name nor an existing file.
-        ModelError: unreadable URDF, missing tool frame, non-revolute joint on the chain.
+        ModelError: unreadable URDF or SRDF, missing tool frame, non-revolute joint on the
+            chain, a package folder that does not exist.
     """
     from lynxplan.robots.loading import load_model
 
     key = str(name_or_urdf)
-    plain = tool is None and base is None and package_dirs is None
+    plain = tool is None and base is None and package_dirs is None and srdf is None
     if plain and key in _CACHE:
         return _CACHE[key]
-    loaded, builtin = load_model(name_or_urdf, tool, base, package_dirs)
+    loaded, builtin = load_model(name_or_urdf, tool, base, package_dirs, srdf)
     robot = Robot(loaded, builtin)
     if plain and builtin is not None:
         _CACHE[key] = robot

@@ -21,6 +21,12 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan.mesh_paths import (
+    build_geometry_model,
+    resolve_mesh,
+    resolve_urdf_meshes,
+)
+
 #: Bump when the hull files change format or content.
 HULL_FORMAT = 1
 #: Environment variable naming the cache folder (default: $XDG_CACHE_HOME/lynxplan).
@@ -38,26 +44,6 @@ def cache_dir() -> Path | None:
     except OSError:
         return None
     return folder if os.access(folder, os.W_OK) else None
-
-
-def resolve_mesh(
-    filename: str, urdf_dir: Path | None, package_dirs: tuple[str, ...]
-) -> Path | None:
-    """The file a URDF mesh ``filename`` names (``package://``, ``file://``, absolute or
-    relative to the URDF or a package folder), or None."""
-    if filename.startswith("file://"):
-        filename = filename[len("file://") :]
-    candidates: list[Path] = []
-    if filename.startswith("package://"):
-        rest = filename[len("package://") :]
-        candidates += [Path(d) / rest for d in package_dirs]
-    elif os.path.isabs(filename):
-        candidates.append(Path(filename))
-    else:
-        if urdf_dir is not None:
-            candidates.append(urdf_dir / filename)
-        candidates += [Path(d) / filename for d in package_dirs]
-    return next((c for c in candidates if c.is_file()), None)
 
 
 def _write_stl(path: Path, points: np.ndarray, triangles: np.ndarray) -> None:
@@ -118,10 +104,14 @@ def hull_urdf(urdf_xml: str, urdf_dir: Path | None, package_dirs: tuple[str, ...
 
 def geometry_model(robot: Any, kind: str, *, hulls: bool) -> Any:
     """Pinocchio GeometryModel of a Robot's URDF elements of ``kind`` ("collision" or
-    "visual"); with ``hulls``, collision meshes replaced by their cached hull files."""
-    import pinocchio as pin
+    "visual"), every mesh found by :func:`lynxplan.mesh_paths.resolve_mesh`; with
+    ``hulls``, collision meshes replaced by their cached hull files.
 
-    dirs = robot._mesh_dirs()
-    xml = hull_urdf(robot._urdf_xml, robot.urdf_path.parent, dirs) if hulls else robot._urdf_xml
-    geometry_type = pin.GeometryType.COLLISION if kind == "collision" else pin.GeometryType.VISUAL
-    return pin.buildGeomFromUrdfString(robot.model, xml, geometry_type, package_dirs=list(dirs))
+    Raises:
+        MeshNotFoundError: a mesh of that kind found nowhere, naming it.
+        ModelError: a mesh file that cannot be read.
+    """
+    xml = resolve_urdf_meshes(robot._urdf_xml, robot.urdf_path, robot.package_dirs, (kind,))
+    if hulls:
+        xml = hull_urdf(xml, robot.urdf_path.parent, robot.package_dirs)
+    return build_geometry_model(robot.model, xml, robot.urdf_path.name, kind)

@@ -46,13 +46,14 @@ class BuiltinRobot:
 
 
 def _example_robot_data_dir() -> Path:
-    try:
-        from example_robot_data.robots_loader import getModelPath
-    except ImportError as exc:  # pragma: no cover - a dependency
+    from lynxplan.mesh_paths import example_robot_data_robots
+
+    robots = example_robot_data_robots()
+    if robots is None:  # pragma: no cover - a dependency
         raise ModelError(
             "example_robot_data is not installed (pip install example-robot-data-loaders)"
-        ) from exc
-    return Path(getModelPath("so_arm_description/urdf/so101.urdf")).resolve()
+        )
+    return robots
 
 
 def builtin_robots() -> dict[str, BuiltinRobot]:
@@ -99,6 +100,9 @@ class LoadedModel:
         locked_joints: Joints off the arm chain, locked at the given angle/position.
         package_dirs: Mesh search folders.
         urdf_xml: The URDF text with the locked joints made fixed (for the geometry models).
+        srdf: The SRDF read, or None.
+        disabled_collisions: Link pairs whose self-collision is not checked (the SRDF's
+            ``disable_collisions``).
     """
 
     name: str
@@ -109,6 +113,8 @@ class LoadedModel:
     locked_joints: tuple[tuple[str, float], ...]
     package_dirs: tuple[str, ...]
     urdf_xml: str
+    srdf: Path | None = None
+    disabled_collisions: tuple[tuple[str, str], ...] = ()
 
 
 def _add_frame(model: Any, name: str, parent_frame: str, translation: Any, rpy: Any) -> None:
@@ -166,13 +172,56 @@ def _lock_joints(xml: str, angles: dict[str, float]) -> str:
     return ET.tostring(root, encoding="unicode")
 
 
+def find_srdf(urdf: Path) -> Path | None:
+    """The SRDF of a URDF where the usual layouts put it: ``<stem>.srdf`` next to it, or in
+    ``../srdf/`` (example-robot-data's ``panda_description/{urdf,srdf}``); None if neither."""
+    name = urdf.with_suffix(".srdf").name
+    return next(
+        (p for p in (urdf.parent / name, urdf.parent.parent / "srdf" / name) if p.is_file()), None
+    )
+
+
+def read_disabled_collisions(srdf: Path) -> tuple[tuple[str, str], ...]:
+    """The link pairs of an SRDF's ``<disable_collisions link1= link2=>`` elements.
+
+    Raises:
+        ModelError: an unreadable SRDF, naming it.
+    """
+    import xml.etree.ElementTree as ET
+
+    try:
+        root = ET.parse(srdf).getroot()
+    except (OSError, ET.ParseError) as exc:
+        raise ModelError(f"cannot read SRDF {srdf}: {exc}") from exc
+    pairs = []
+    for element in root.iter("disable_collisions"):
+        first, second = element.get("link1"), element.get("link2")
+        if not first or not second:
+            raise ModelError(f"SRDF {srdf.name}: disable_collisions needs link1 and link2")
+        pairs.append((first, second))
+    return tuple(pairs)
+
+
+def _srdf_of(urdf: Path, srdf: str | Path | None) -> Path | None:
+    if srdf is None:
+        return find_srdf(urdf)
+    path = Path(srdf)
+    if not path.is_file():
+        raise ModelError(f"SRDF file not found: {srdf}")
+    return path
+
+
 def load_model(  # noqa: PLR0912, PLR0915 (URDF reading steps in order)
     name_or_urdf: str | Path,
     tool: str | None,
     base: np.ndarray | None,
     package_dirs: tuple[str, ...] | list[str] | None,
+    srdf: str | Path | None = None,
 ) -> tuple[LoadedModel, BuiltinRobot | None]:
     """Read a built-in robot or a URDF into a fixed-base arm chain ending at the tool frame.
+
+    ``package_dirs`` are searched first for its meshes (see :mod:`lynxplan.mesh_paths`); the
+    SRDF (``srdf``, else :func:`find_srdf`) names the link pairs not checked for self-collision.
 
     Raises:
         UnknownRobotError: a name that is neither a built-in nor an existing file.
@@ -191,6 +240,11 @@ def load_model(  # noqa: PLR0912, PLR0915 (URDF reading steps in order)
         if not urdf.is_file():
             raise UnknownRobotError(str(name_or_urdf), tuple(builtins))
         name, dirs = urdf.name, tuple(package_dirs or ())
+    for folder in dirs:
+        if not Path(folder).is_dir():
+            raise ModelError(f"package_dirs: {folder} is not a folder")
+    srdf_path = _srdf_of(urdf, srdf)
+    disabled = read_disabled_collisions(srdf_path) if srdf_path is not None else ()
     try:
         xml = urdf.read_text()
         full = pin.buildModelFromXML(xml)
@@ -245,6 +299,8 @@ def load_model(  # noqa: PLR0912, PLR0915 (URDF reading steps in order)
             locked_joints,
             dirs,
             xml,
+            srdf_path,
+            disabled,
         ),
         spec,
     )

@@ -73,6 +73,7 @@ class Robot:
         limits: Joint position and velocity limits (``position`` (n, 2) [rad], ``velocity`` (n,)).
         family: Recognised family parameters, or None (then IK is numerical).
         family_reason: The family name, or why the chain is not in it.
+        disabled_collisions: Link pairs not checked for self-collision (from the SRDF).
         nq: Number of joints.
     """
 
@@ -85,6 +86,7 @@ class Robot:
         self.tool_frame_id = loaded.tool_frame_id
         self.locked_joints = loaded.locked_joints
         self.package_dirs = loaded.package_dirs
+        self.disabled_collisions = loaded.disabled_collisions
         self._urdf_xml = loaded.urdf_xml
         self.builtin = builtin
         self.nq = int(self.model.nq)
