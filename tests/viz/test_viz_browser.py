@@ -6,7 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from browser import CHROMIUM, neutral, orange, screenshot
+from browser import CHROMIUM, neutral, orange, path_red, screenshot
 
 from lynxplan.collision import SphereObstacle, axis_aligned_box
 from lynxplan.viz import export_html, tilted_plane
@@ -116,3 +116,30 @@ def test_animation_plays_to_the_last_pose(arm, tmp_path):
     wrist_start = _project(arm.frame_placement(POSE, "dh_frame_4")[:3, 3])
     assert _window(_neutral(image), wrist_end, 4).mean() > 0.9
     assert not _window(_neutral(image), wrist_start, 4).any()
+
+
+def _floor(pixels: np.ndarray) -> np.ndarray:
+    """The floor grid's pale blue (the sky behind the floor, in the lower half, is dark)."""
+    r, b = pixels[..., 0], pixels[..., 2]
+    return (b - r > 40) & (r > 120)
+
+
+def test_default_view_frames_the_strokes_over_a_floor_and_through_obstacles(arm, tmp_path):
+    """No camera given: the page looks at the pen path, draws a floor grid under the arm, and
+    the strokes inside a translucent box stay pure red (drawn over the obstacles)."""
+    if CHROMIUM is None:
+        pytest.skip("chromium is not installed (apt-get install chromium)")
+    square = np.array([[-0.03, 0.22, -0.02], [0.03, 0.22, -0.02], [0.03, 0.28, -0.02],
+                       [-0.03, 0.28, -0.02], [-0.03, 0.22, -0.02]])  # fmt: skip
+    jar = axis_aligned_box("jar", [-0.06, 0.19, -0.06], [0.12, 0.12, 0.08])
+    q = np.stack([POSE, POSE])
+    html = export_html(arm, q, np.array([0.0, 1.0]), tmp_path / "task.html", path=square,
+                       motion=["line"] * 5, obstacles=[jar], autoplay=False)  # fmt: skip
+    image = _screenshot(html, tmp_path / "task.png", tmp_path / "profile")
+    red = path_red(image)
+    assert red.sum() >= 100  # four 6 cm strokes (~150 px), not tinted by the box
+    rows, cols = np.nonzero(red)
+    # Framed: the strokes lie around the middle of the picture, not at its edge.
+    assert 0.2 * HEIGHT < rows.mean() < 0.8 * HEIGHT
+    assert 0.2 * WIDTH < cols.mean() < 0.8 * WIDTH
+    assert _floor(image[HEIGHT // 2 :]).sum() >= 500
