@@ -1,12 +1,12 @@
-"""Shared helpers for sub-commands: JSON output, number parsing and IK branch listings."""
+"""Shared helpers for sub-commands: JSON output and number parsing (IK answers:
+:mod:`lynxplan.commands._ik_answer`)."""
 
 from __future__ import annotations
 
 import json
 import math
 import sys
-from collections.abc import Sequence
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 
@@ -68,77 +68,70 @@ def parse_finite(text: str, name: str) -> float:
     return value
 
 
-class _IkBranch(Protocol):
-    """What an IK listing reads of one branch (arm and URDF-robot results alike)."""
-
-    @property
-    def q(self) -> np.ndarray: ...
-    @property
-    def branch(self) -> str: ...
-    @property
-    def within_limits(self) -> bool: ...
-    @property
-    def orientation_error(self) -> float: ...
-    @property
-    def position_error(self) -> float: ...
-
-
-class _IkAnswer(Protocol):
-    """What an IK listing reads of a result."""
-
-    @property
-    def solutions(self) -> Sequence[_IkBranch]: ...
-    @property
-    def selected(self) -> int | None: ...
-    @property
-    def orientation_residual(self) -> float: ...
-
-
-def ik_branch_rows(
-    result: _IkAnswer, *, show_all: bool, angle_scale: float, length_scale: float
-) -> tuple[list[dict[str, Any]], int | None]:
-    """The branches an ``ik`` command lists (every one, or those within the joint limits).
+def parse_pose(text: str, length_unit: str) -> np.ndarray:
+    """JSON 4x4 or 3x4 nested list -> (4, 4) pose in [m], checked by :func:`guards.poses`.
 
     Args:
-        result: The IK result.
-        show_all: List every branch, not only those within limits (``--all``).
-        angle_scale: Size of the output angle unit, in [rad].
-        length_scale: Size of the output length unit, in [m].
-
-    Returns:
-        One JSON-ready row per listed branch (``q`` in the angle unit, ``position_error`` in the
-        length unit, ``orientation_error`` in [rad]) and the selected branch's index among the
-        rows (None when it is not listed).
+        text: The ``--pose`` value.
+        length_unit: Unit of its translation (``m``, ``mm``, ``in``).
     """
-    listed = [i for i, s in enumerate(result.solutions) if show_all or s.within_limits]
-    rows = [
-        {
-            "q": (result.solutions[i].q / angle_scale).tolist(),
-            "branch": result.solutions[i].branch,
-            "within_limits": result.solutions[i].within_limits,
-            "position_error": result.solutions[i].position_error / length_scale,
-            "orientation_error": result.solutions[i].orientation_error,
-        }
-        for i in listed
-    ]
-    selected = listed.index(result.selected) if result.selected in listed else None
-    return rows, selected
+    from lynxplan import guards
+    from lynxplan.exceptions import ShapeError
+    from lynxplan.units import length_factor
+
+    pose = parse_json_numbers(text, "--pose", "a JSON 4x4 (or 3x4) nested list of numbers")
+    if pose.shape == (3, 4):
+        pose = np.vstack([pose, [0.0, 0.0, 0.0, 1.0]])
+    if pose.shape != (4, 4):
+        raise ShapeError("--pose", "(4, 4) or (3, 4)", pose.shape)
+    guards.finite_array("--pose", pose)
+    pose[:3, 3] *= length_factor(length_unit)
+    return guards.poses("--pose", pose, batch=False)
 
 
-def print_ik_branches(
-    result: _IkAnswer,
-    rows: Sequence[dict[str, Any]],
-    selected: int | None,
+def check_joint_limits(
+    q: np.ndarray,
+    names: tuple[str, ...],
+    lower: np.ndarray,
+    upper: np.ndarray,
     angle_unit: str,
-    branch_width: int,
 ) -> None:
-    """Print the orientation residual and the rows of :func:`ik_branch_rows`, the selected one
-    marked ``*``; ``branch_width`` is the width of the branch-name column, in characters."""
-    print(f"orientation residual: {result.orientation_residual:.3g} rad")
-    if not rows:
-        print("no solution within the joint limits (use --all to list every branch)")
-    for k, row in enumerate(rows):
-        mark = "*" if k == selected else " "
-        angles = "  ".join(f"{v:10.4f}" for v in row["q"])
-        flag = "" if row["within_limits"] else "  (outside limits)"
-        print(f"{mark} {row['branch']:<{branch_width}} {angles} {angle_unit}{flag}")
+    """Joint angles beyond a joint's limits are an error (``fk``: 90 taken as radians is a
+    typo, not a pose), naming the joint, its value and limits in ``angle_unit``, and suggesting
+    ``--deg`` where the values read as degrees would be within the limits.
+
+    Args:
+        q: Joint angles, shape (n,), in [rad].
+        names: Joint names (the argument is ``q<i> (joint <name>)``).
+        lower, upper: Position limits, shape (n,), in [rad]; a value this close to a limit
+            (``LIMIT_SNAP_TOLERANCE``) counts as on it.
+        angle_unit: Unit the user gave the angles in (``rad`` or ``deg``).
+
+    Raises:
+        OutOfRangeError: naming the first joint beyond its limits.
+    """
+    from lynxplan.constants import LIMIT_SNAP_TOLERANCE
+    from lynxplan.exceptions import OutOfRangeError
+
+    slack = LIMIT_SNAP_TOLERANCE
+    outside = (q < lower - slack) | (q > upper + slack)
+    if not outside.any():
+        return
+    scale = math.pi / 180.0 if angle_unit == "deg" else 1.0
+    j = int(np.flatnonzero(outside)[0])
+    given = q / scale
+    hint = ""
+    as_degrees = np.radians(given)
+    if angle_unit == "rad" and bool(
+        np.all((as_degrees >= lower - slack) & (as_degrees <= upper + slack))
+    ):
+        hint = "; the values look like degrees: add --deg"
+    elif angle_unit == "rad" and float(np.abs(given).max()) > 2 * math.pi:
+        hint = "; angles are in rad unless --deg is given"
+    label = f"q{j + 1}" if names[j] == f"q{j + 1}" else f"q{j + 1} (joint {names[j]})"
+    raise OutOfRangeError(
+        label,
+        float(given[j]),
+        f"within the joint's limits [{lower[j] / scale:.6g}, {upper[j] / scale:.6g}] "
+        f"{angle_unit}{hint} (--ignore-limits computes the pose anyway)",
+    )

@@ -12,15 +12,16 @@ from typing import Any
 import numpy as np
 
 from lynxplan import guards
+from lynxplan.commands import _ik_answer as _ik
 from lynxplan.commands import robots as robots_cmd
 from lynxplan.commands._output import (
-    ik_branch_rows,
+    check_joint_limits,
     parse_finite,
     parse_json_numbers,
-    print_ik_branches,
+    parse_pose,
     print_json,
 )
-from lynxplan.exceptions import InputError, ShapeError
+from lynxplan.exceptions import InputError, ShapeError, UnreachablePoseError
 from lynxplan.units import LENGTH_UNITS, angle_factor, length_factor
 
 
@@ -29,6 +30,11 @@ def register(subparsers: Any) -> None:
     fk = subparsers.add_parser("fk", help="forward kinematics: joint angles -> tool pose")
     fk.add_argument(
         "q", nargs="*", metavar="Q", help="joint angles q1..q5 (rad, or deg with --deg)"
+    )
+    fk.add_argument(
+        "--ignore-limits",
+        action="store_true",
+        help="compute the pose of angles beyond the joint limits (default: an error)",
     )
     _add_unit_options(fk)
     robots_cmd.add_robot_options(fk)
@@ -45,7 +51,12 @@ def register(subparsers: Any) -> None:
     ik.add_argument(
         "--all", action="store_true", help="list every branch, not only those in limits"
     )
-    ik.add_argument("--strict", action="store_true", help="fail if the orientation is unreachable")
+    ik.add_argument(
+        "--strict",
+        action="store_true",
+        help="exit 2 unless a branch within the joint limits reaches the target (orientation"
+        " within --tolerance); without it, the JSON status/message say why there is none",
+    )
     ik.add_argument(
         "--tolerance", default="1e-6", help="strict orientation tolerance in rad (default 1e-6)"
     )
@@ -77,6 +88,7 @@ def handle_fk(args: argparse.Namespace) -> int:
     """Print the tool pose of the given joint angles."""
     from lynxplan.arm import load_arm
     from lynxplan.arm.closed_form import tool_pose  # one pose: no numba import, fast start
+    from lynxplan.arm.geometry import JOINT_NAMES
 
     if robots_cmd.wants_robot(args):
         return robots_cmd.handle_robot_fk(args)
@@ -85,7 +97,11 @@ def handle_fk(args: argparse.Namespace) -> int:
         raise InputError(f"fk: expected 5 joint angles q1..q5, got {len(args.q)}")
     check = guards.angle_deg if args.deg else guards.angle
     q = np.array([check(f"q{i + 1}", parse_finite(t, f"q{i + 1}")) for i, t in enumerate(args.q)])
-    T = tool_pose(q * angle_factor(units["angle"]), load_arm().geometry)
+    q = q * angle_factor(units["angle"])
+    arm = load_arm()
+    if not args.ignore_limits:
+        check_joint_limits(q, JOINT_NAMES, arm.limits.lower, arm.limits.upper, units["angle"])
+    T = tool_pose(q, arm.geometry)
     T[:3, 3] /= length_factor(units["length"])
     if args.json:
         print_json({"T": T, "units": units})
@@ -96,21 +112,11 @@ def handle_fk(args: argparse.Namespace) -> int:
     return 0
 
 
-def parse_pose(text: str, length_unit: str) -> np.ndarray:
-    """JSON 4x4 or 3x4 nested list -> (4, 4) pose in [m], checked by :func:`guards.poses`."""
-    pose = parse_json_numbers(text, "--pose", "a JSON 4x4 (or 3x4) nested list of numbers")
-    if pose.shape == (3, 4):
-        pose = np.vstack([pose, [0.0, 0.0, 0.0, 1.0]])
-    if pose.shape != (4, 4):
-        raise ShapeError("--pose", "(4, 4) or (3, 4)", pose.shape)
-    guards.finite_array("--pose", pose)
-    pose[:3, 3] *= length_factor(length_unit)
-    return guards.poses("--pose", pose, batch=False)
-
-
 def handle_ik(args: argparse.Namespace) -> int:
     """Print every IK branch of a pose and the selected one."""
     from lynxplan.arm import load_arm
+    from lynxplan.arm.geometry import JOINT_NAMES
+    from lynxplan.arm.ik_result import IkResult
 
     if robots_cmd.wants_robot(args) or args.position is not None:
         return robots_cmd.handle_robot_ik(args)
@@ -128,30 +134,33 @@ def handle_ik(args: argparse.Namespace) -> int:
         if given.shape != (5,):
             raise ShapeError("--reference", "(5,)", given.shape)
         reference = guards.angles("--reference", given * scale)
-    result = load_arm().ik(
-        pose,
-        q_reference=reference,
-        select=args.select,
-        strict=args.strict,
-        orientation_tolerance=guards.tolerance("--tolerance", args.tolerance, "rad"),
-    )
-    solutions, selected = ik_branch_rows(
+    tolerance = guards.tolerance("--tolerance", args.tolerance, "rad")
+    arm = load_arm()
+    answer_units = _ik.Units(units["angle"], units["length"])
+    try:
+        result = arm.ik(pose, q_reference=reference, select=args.select)
+    except UnreachablePoseError as exc:
+        if args.strict:
+            raise
+        result, reachable, distance = IkResult((), None, float("nan")), False, exc.distance
+    else:
+        reachable, distance = True, 0.0
+    answer = _ik.ik_answer(
         result,
+        _ik.JointTable(JOINT_NAMES, arm.limits.lower, arm.limits.upper),
+        answer_units,
         show_all=args.all,
-        angle_scale=scale,
-        length_scale=length_factor(units["length"]),
+        reachable=reachable,
+        distance=distance,
     )
-    if args.json:
-        print_json(
-            {
-                "solutions": solutions,
-                "selected": selected,
-                # branches not listed (outside the joint limits; --all lists them)
-                "outside_limits_not_listed": len(result.solutions) - len(solutions),
-                "orientation_residual": result.orientation_residual,
-                "units": {**units, "orientation_error": "rad", "position_error": units["length"]},
-            }
-        )
-        return 0
-    print_ik_branches(result, solutions, selected, units["angle"], branch_width=17)
+    if args.strict:
+        _ik.check_strict(answer, tolerance, answer_units)
+    _ik.emit(
+        answer,
+        answer_units,
+        as_json=args.json,
+        header={},
+        footer={"units": {**units, "orientation_error": "rad", "position_error": units["length"]}},
+        branch_width=17,
+    )
     return 0

@@ -13,7 +13,12 @@ from typing import Any
 
 import numpy as np
 
-from lynxplan.commands._output import ik_branch_rows, parse_finite, print_ik_branches, print_json
+from lynxplan.commands._output import (
+    check_joint_limits,
+    parse_finite,
+    parse_pose,
+    print_json,
+)
 from lynxplan.exceptions import InputError
 from lynxplan.units import angle_factor, length_factor
 
@@ -149,7 +154,10 @@ def handle_robot_fk(args: argparse.Namespace) -> int:
     if len(args.q) != robot.nq:
         raise InputError(f"fk: {robot.name} has {robot.nq} joints; got {len(args.q)} angles")
     q = np.array([parse_finite(t, f"q{i + 1}") for i, t in enumerate(args.q)])
-    T = robot.fk(q * angle_factor(unit_angle))
+    q = q * angle_factor(unit_angle)
+    if not args.ignore_limits:
+        check_joint_limits(q, robot.joint_names, robot.limits.lower, robot.limits.upper, unit_angle)
+    T = robot.fk(q)
     T[:3, 3] /= length_factor(unit_length)
     if args.json:
         print_json(
@@ -164,8 +172,10 @@ def handle_robot_fk(args: argparse.Namespace) -> int:
 
 def handle_robot_ik(args: argparse.Namespace) -> int:
     """ik with --robot/--urdf or --position: every verified branch of a robot's target."""
-    from lynxplan.commands.arm import parse_pose
+    from lynxplan import guards
+    from lynxplan.commands import _ik_answer as _ik
 
+    tolerance = guards.tolerance("--tolerance", args.tolerance, "rad")
     robot = _load(args)
     unit_length, unit_angle = args.units, "deg" if args.deg else "rad"
     length, scale = length_factor(unit_length), angle_factor(unit_angle)
@@ -202,37 +212,35 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
             "ik: the following arguments are required: --pose"
             " (or --position with --approach or --pitch)"
         )
-    solutions, selected = ik_branch_rows(
-        result, show_all=args.all, angle_scale=scale, length_scale=length
+    answer_units = _ik.Units(unit_angle, unit_length)
+    answer = _ik.ik_answer(
+        result,
+        _ik.JointTable(robot.joint_names, robot.limits.lower, robot.limits.upper),
+        answer_units,
+        show_all=args.all,
+        reachable=result.reachable,
+        distance=result.distance,
     )
-    for row in solutions:
+    for row in answer["solutions"]:
         row["verified"] = True
-    if args.json:
-        print_json(
-            {
-                "robot": robot.name,
-                "solver": result.solver,
-                "reachable": result.reachable,
-                "distance": result.distance / length,
-                "solutions": solutions,
-                "selected": selected,
-                # branches not listed (outside the joint limits; --all lists them)
-                "outside_limits_not_listed": len(result.solutions) - len(solutions),
-                "orientation_residual": result.orientation_residual,
-                "verification": "every branch: Pinocchio frame placement == solver FK to 1e-12 m",
-                "units": {
-                    "length": unit_length,
-                    "angle": unit_angle,
-                    "orientation_error": "rad",
-                    "position_error": unit_length,
-                },
-            }
-        )
-        return 0
-    print(f"{robot.name}: {result.solver}")
-    if not result.reachable:
-        print(
-            f"unreachable: nearest solution misses by {result.distance / length:.6g} {unit_length}"
-        )
-    print_ik_branches(result, solutions, selected, unit_angle, branch_width=24)
+    if args.strict:
+        _ik.check_strict(answer, tolerance, answer_units)
+    if not args.json:
+        print(f"{robot.name}: {result.solver}")
+    _ik.emit(
+        answer,
+        answer_units,
+        as_json=args.json,
+        header={"robot": robot.name, "solver": result.solver},
+        footer={
+            "verification": "every branch: Pinocchio frame placement == solver FK to 1e-12 m",
+            "units": {
+                "length": unit_length,
+                "angle": unit_angle,
+                "orientation_error": "rad",
+                "position_error": unit_length,
+            },
+        },
+        branch_width=24,
+    )
     return 0

@@ -64,7 +64,7 @@ def test_ik_without_all_lists_only_solutions_within_limits(capsys) -> None:
         (("ik", "--pose", "[[1, 0], [0, 1]]"), r"--pose must have shape \(4, 4\) or \(3, 4\)"),
         (("ik", "--pose", "[[2,0,0,0.1],[0,1,0,0],[0,0,1,0]]"), "not a rigid transform"),
         (("ik", "--pose", "[[1,0,0,NaN],[0,1,0,0],[0,0,1,0]]"), r"--pose contains NaN .*3\] = nan"),
-        (("ik", "--pose", "[[1,0,0,5],[0,1,0,0],[0,0,1,0]]"), "out of reach"),
+        (("ik", "--pose", "[[1,0,0,5],[0,1,0,0],[0,0,1,0]]", "--strict"), "out of reach"),
         (("ik", "--pose", O2_POSE, "--units", "in", "--strict"), "exceeds the strict tolerance"),
         (("run", "/nonexistent/scenario.yaml"), "file not found"),
         (("workspace", "--samples", "0"), "--samples = 0 is out of range: must be an integer >= 1"),
@@ -155,7 +155,9 @@ def test_workspace_command_writes_plots_and_json(capsys, tmp_path: Path) -> None
 
 
 def test_every_negative_number_form_is_a_value(capsys) -> None:
-    code, out, _ = run_cli(capsys, "fk", "-1e-3", "-5.", "-.5", "-0", "0", "--json")
+    code, out, _ = run_cli(
+        capsys, "fk", "-1e-3", "-5.", "-.5", "-0", "0", "--json", "--ignore-limits"
+    )
     assert code == 0
     expected = np.array(json.loads(out)["T"])
     from lynxplan.arm import forward_kinematics

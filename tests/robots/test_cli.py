@@ -32,20 +32,19 @@ def test_robot_info_shows_the_family(capsys: pytest.CaptureFixture[str]) -> None
     assert data["joints"][0]["upper"] == pytest.approx(110.0, abs=1e-3)  # type: ignore[index]
 
 
-def test_ik_json_counts_the_branches_outside_the_limits(
+def test_ik_json_lists_the_branches_when_none_is_within_the_limits(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
-    """Straight down at (0.2, 0, 0.1) the SO-101 reaches only outside its joint limits: no
-    branch listed, and the JSON says how many were left out (``--all`` lists them)."""
+    """Straight down at (0.2, 0, 0.1) the SO-101 reaches only outside its joint limits: every
+    branch is listed anyway, each naming the joints it breaks (issue 34)."""
     argv = ["ik", "--robot", "so101", "--position", "0.2", "0", "0.1", "--approach", "0", "0", "-1"]
     data = _json(capsys, [*argv, "--json"])
     library = load_robot("so101").ik(position=[0.2, 0, 0.1], approach=[0, 0, -1])
-    outside = sum(not s.within_limits for s in library.solutions)
-    assert outside > 0 and data["solutions"] == []  # type: ignore[index]
-    assert data["outside_limits_not_listed"] == outside  # type: ignore[index]
-    listed = _json(capsys, [*argv, "--json", "--all"])
-    assert len(listed["solutions"]) == len(library.solutions)  # type: ignore[index,arg-type]
-    assert listed["outside_limits_not_listed"] == 0  # type: ignore[index]
+    assert not any(s.within_limits for s in library.solutions)
+    assert len(data["solutions"]) == len(library.solutions)  # type: ignore[index,arg-type]
+    assert data["outside_limits_not_listed"] == 0  # type: ignore[index]
+    assert data["status"] == "no_solution_within_limits"  # type: ignore[index]
+    assert all(s["violations"] for s in data["solutions"])  # type: ignore[index,union-attr]
 
 
 def test_ik_position_approach_returns_verified_branches(capsys: pytest.CaptureFixture[str]) -> None:
