@@ -88,9 +88,9 @@ def plot_workspace(
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 5))
     views = (
-        ("x", "y", 0, 1, "in Z (x-y)"),
-        ("x", "z", 0, 2, "in Y (x-z)"),
-        ("y", "z", 1, 2, "in X (y-z)"),
+        ("x", "y", 0, 1, "top view: projection onto the x-y plane"),
+        ("x", "z", 0, 2, "front view: projection onto the x-z plane"),
+        ("y", "z", 1, 2, "side view: projection onto the y-z plane"),
     )
     for ax, (h, v, i, j, title) in zip(axes, views, strict=True):
         ax.scatter(cloud[:, i], cloud[:, j], s=0.2, c=colour, cmap="viridis")
@@ -128,8 +128,9 @@ def plot_workspace(
     ax.set(
         xlabel=f"radial distance [{length_unit}]",
         ylabel=f"height z [{length_unit}]",
-        title=f"Cross-section: reach envelope, volume {estimate.volume_revolution * 1e3:.1f} L "
-        f"(cell {env.cell * 1e3:g} mm)",
+        title=f"Cross-section: reach envelope, volume "
+        f"{estimate.volume_revolution / scale**3:.4g} {length_unit}^3 "
+        f"(cell {env.cell / scale:.3g} {length_unit})",
         aspect="equal",
     )
     ax.legend(loc="lower right")
@@ -144,26 +145,64 @@ _HTML_TEMPLATE = """<!DOCTYPE html>
 <html><head><meta charset="utf-8"><title>lynxplan workspace</title>
 <style>body{margin:0;font-family:sans-serif;background:#fff}canvas{display:block}
 #info{position:absolute;top:8px;left:10px;font-size:13px;color:#222}</style></head>
-<body><div id="info">lynxplan workspace: __COUNT__ tool points, lengths in __UNIT__.
-Drag to rotate, wheel to zoom.</div><canvas id="c"></canvas>
+<body><div id="info">lynxplan workspace: __COUNT__ tool points coloured by height z, lengths in
+__UNIT__; the robot (dark) at the middle of its joint ranges. Drag to rotate, wheel to zoom.</div>
+<canvas id="c"></canvas>
 <script>
 const P = __POINTS__;
+const ROBOT = __ROBOT__;
+const E = __EXTENT__, ZLO = __ZLO__, ZHI = __ZHI__, UNIT = "__UNIT__";
+const VIRIDIS = [[68,1,84],[59,82,139],[33,145,140],[94,201,98],[253,231,37]];
 const cv = document.getElementById('c'), g = cv.getContext('2d');
 let yaw = 0.8, pitch = 0.5, zoom = 1.0, drag = null;
+function colour(z) {
+  const t = Math.min(Math.max((z - ZLO) / Math.max(ZHI - ZLO, 1e-9), 0), 1) * 4;
+  const i = Math.min(Math.floor(t), 3), f = t - i, a = VIRIDIS[i], b = VIRIDIS[i + 1];
+  return `rgb(${a.map((c, k) => Math.round(c + f * (b[k] - c))).join(',')})`;
+}
+function project(x, y, z, s) {
+  const cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);
+  const u = cy * x - sy * y, w = sy * x + cy * y;
+  return [cv.width / 2 + s * u, cv.height / 2 - s * (cp * z - sp * w)];
+}
+function line(a, b, s, style, width) {
+  const p = project(...a, s), q = project(...b, s);
+  g.strokeStyle = style; g.lineWidth = width;
+  g.beginPath(); g.moveTo(...p); g.lineTo(...q); g.stroke();
+}
 function resize(){ cv.width = innerWidth; cv.height = innerHeight; draw(); }
 function draw(){
   g.fillStyle = '#fff'; g.fillRect(0, 0, cv.width, cv.height);
-  const s = zoom * Math.min(cv.width, cv.height) / (2.4 * __EXTENT__);
-  const cy = Math.cos(yaw), sy = Math.sin(yaw), cp = Math.cos(pitch), sp = Math.sin(pitch);
+  const s = zoom * Math.min(cv.width, cv.height) / (2.4 * E);
   for (let i = 0; i < P.length; i += 3) {
-    const x = P[i], y = P[i+1], z = P[i+2];
-    const u = cy * x - sy * y, w = sy * x + cy * y;
-    const v = cp * z - sp * w;
-    const t = (z + __EXTENT__) / (2 * __EXTENT__);
-    const red = Math.round(40 + 200 * t), green = Math.round(90 + 80 * (1 - t));
-    g.fillStyle = `rgb(${red},${green},${Math.round(200 - 150 * t)})`;
-    g.fillRect(cv.width / 2 + s * u, cv.height / 2 - s * v, 1.5, 1.5);
+    const p = project(P[i], P[i+1], P[i+2], s);
+    g.fillStyle = colour(P[i+2]);
+    g.fillRect(p[0], p[1], 1.5, 1.5);
   }
+  const axes = [[[E, 0, 0], '#d62728', 'x'], [[0, E, 0], '#2ca02c', 'y'],
+                [[0, 0, E], '#1f77b4', 'z']];
+  g.font = '14px sans-serif';
+  for (const [end, style, name] of axes) {
+    line([0, 0, 0], end, s, style, 2);
+    const p = project(...end, s);
+    const label = `${name} (${E.toFixed(1)} ${UNIT})`;
+    g.strokeStyle = '#fff'; g.lineWidth = 4; g.strokeText(label, p[0] + 4, p[1] - 4);
+    g.fillStyle = style; g.fillText(label, p[0] + 4, p[1] - 4);
+  }
+  for (let i = 0; i + 1 < ROBOT.length; i++) line(ROBOT[i], ROBOT[i + 1], s, '#222', 6);
+  g.fillStyle = '#000';
+  for (const joint of ROBOT) {
+    const p = project(...joint, s);
+    g.beginPath(); g.arc(p[0], p[1], 4, 0, 2 * Math.PI); g.fill();
+  }
+  const x0 = cv.width - 40, top = 60, height = Math.min(240, cv.height - 120);
+  for (let k = 0; k < height; k++) {
+    g.fillStyle = colour(ZHI - (ZHI - ZLO) * k / height); g.fillRect(x0, top + k, 16, 1);
+  }
+  g.fillStyle = '#222'; g.textAlign = 'right';
+  g.fillText(`z ${ZHI.toFixed(1)} ${UNIT}`, x0 - 4, top + 10);
+  g.fillText(`${ZLO.toFixed(1)}`, x0 - 4, top + height);
+  g.textAlign = 'left';
 }
 cv.onmousedown = e => drag = [e.clientX, e.clientY];
 onmouseup = () => drag = null;
@@ -175,15 +214,46 @@ onresize = resize; resize();
 """
 
 
-def write_html(points: np.ndarray, path: Path, length_unit: str = "in") -> None:
-    """Self-contained interactive HTML point cloud (no network, no external scripts)."""
-    cloud = _subsample(points, _PLOT_POINTS) / length_factor(length_unit)
-    extent = float(np.abs(cloud).max()) if cloud.size else 1.0
+def reference_skeleton(robot: Any) -> np.ndarray:
+    """The robot drawn as a polyline: its joint origins and tool point at the middle of its
+    joint ranges, shape (K, 3), in [m] (repeated points dropped)."""
+    import pinocchio as pin
+
+    model = robot.model
+    lower = np.nan_to_num(np.asarray(model.lowerPositionLimit, float), posinf=0.0, neginf=0.0)
+    upper = np.nan_to_num(np.asarray(model.upperPositionLimit, float), posinf=0.0, neginf=0.0)
+    q = 0.5 * (np.clip(lower, -np.pi, np.pi) + np.clip(upper, -np.pi, np.pi))
+    data = model.createData()
+    pin.forwardKinematics(model, data, q)
+    points = [np.zeros(3)] + [data.oMi[j].translation.copy() for j in range(1, model.njoints)]
+    points.append(np.asarray(robot.fk(q))[:3, 3])
+    kept = [points[0]]
+    for point in points[1:]:
+        if np.linalg.norm(point - kept[-1]) > 1e-6:
+            kept.append(point)
+    return np.array(kept)
+
+
+def write_html(
+    points: np.ndarray, path: Path, length_unit: str = "in", skeleton: np.ndarray | None = None
+) -> None:
+    """Self-contained interactive HTML point cloud (no network, no external scripts): the points
+    coloured by height with a colour bar, the x, y, z axes at the base, and the robot as a
+    polyline (``skeleton`` (K, 3) [m], see :func:`reference_skeleton`) when given."""
+    scale = length_factor(length_unit)
+    cloud = _subsample(points, _PLOT_POINTS) / scale
+    robot = np.zeros((0, 3)) if skeleton is None else np.asarray(skeleton, float) / scale
+    every = np.vstack([cloud, robot]) if cloud.size else robot
+    extent = float(np.abs(every).max()) if every.size else 1.0
+    z = cloud[:, 2] if cloud.size else np.zeros(1)
     flat = ",".join(f"{v:.3f}" for v in cloud.ravel())
     html = (
         _HTML_TEMPLATE.replace("__POINTS__", f"[{flat}]")
+        .replace("__ROBOT__", json.dumps(np.round(robot, 4).tolist()))
         .replace("__UNIT__", length_unit)
         .replace("__COUNT__", f"{cloud.shape[0]:,}")
         .replace("__EXTENT__", f"{extent:.3f}")
+        .replace("__ZLO__", f"{float(z.min()):.4f}")
+        .replace("__ZHI__", f"{float(z.max()):.4f}")
     )
     path.write_text(html, encoding="utf-8")

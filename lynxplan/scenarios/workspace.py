@@ -149,8 +149,14 @@ def _run_sampled(scenario: Input, robot: Any) -> KindOutput:
 
 def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: bool) -> list[str]:
     """``workspace.json`` (in the file's unit) and, unless quick, the plots and the HTML view."""
-    from lynxplan.arm.workspace_report import plot_workspace, workspace_summary, write_html
+    from lynxplan.arm.workspace_report import (
+        plot_workspace,
+        reference_skeleton,
+        workspace_summary,
+        write_html,
+    )
     from lynxplan.scenarios.report import write_json
+    from lynxplan.scenarios.robot import load_robot_entry
 
     unit = scenario.units.length
     if not isinstance(output.payload, tuple):  # a URDF robot: the sampled points
@@ -158,12 +164,14 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
         write_json(out_dir / "workspace.json", {**output.details, **output.metrics, "units": units})
         if quick:
             return ["workspace.json"]
-        write_html(output.payload.positions, out_dir / "workspace.html", unit)
+        skeleton = reference_skeleton(load_robot_entry(scenario.robot))
+        write_html(output.payload.positions, out_dir / "workspace.html", unit, skeleton)
         return ["workspace.json", "workspace.html"]
     estimate, grid = output.payload
     write_json(out_dir / "workspace.json", workspace_summary(estimate, grid, unit))
     if quick:
         return ["workspace.json"]
     paths = plot_workspace(estimate, grid, out_dir, unit)
-    write_html(estimate.positions, out_dir / "workspace.html", unit)
+    skeleton = reference_skeleton(load_robot_entry(scenario.robot))
+    write_html(estimate.positions, out_dir / "workspace.html", unit, skeleton)
     return ["workspace.json", "workspace.html", *(p.name for p in paths)]
