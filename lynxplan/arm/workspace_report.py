@@ -52,6 +52,18 @@ def _subsample(points: np.ndarray, count: int) -> np.ndarray:
     return points[index]
 
 
+def _save(fig: Any, path: Path) -> None:
+    """Write ``fig`` as PNG; its titles and axis labels (with their units) also go into the
+    PNG's ``Description`` text chunk, so the file says what it shows in words too."""
+    texts = []
+    for ax in fig.axes:
+        labels = [ax.get_title(), ax.get_xlabel(), ax.get_ylabel()]
+        if hasattr(ax, "get_zlabel"):
+            labels.append(ax.get_zlabel())
+        texts.append(", ".join(t for t in labels if t))
+    fig.savefig(path, dpi=110, bbox_inches="tight", metadata={"Description": " | ".join(texts)})
+
+
 def plot_workspace(
     estimate: WorkspaceEstimate,
     report_points: np.ndarray | None,
@@ -79,11 +91,11 @@ def plot_workspace(
         xlabel=f"x [{length_unit}]",
         ylabel=f"y [{length_unit}]",
         zlabel=f"z [{length_unit}]",
-        title="Tool-point workspace (3-D)",
+        title=f"Tool-point workspace (3-D), lengths in {length_unit}",
     )
     ax.set_box_aspect((2, 1, 1.2))
     paths.append(out_dir / "workspace_3d.png")
-    fig.savefig(paths[-1], dpi=110, bbox_inches="tight")
+    _save(fig, paths[-1])
     plt.close(fig)
 
     fig, axes = plt.subplots(1, 3, figsize=(15, 5))
@@ -102,7 +114,7 @@ def plot_workspace(
         )
         ax.grid(alpha=0.3)
     paths.append(out_dir / "workspace_projections.png")
-    fig.savefig(paths[-1], dpi=110, bbox_inches="tight")
+    _save(fig, paths[-1])
     plt.close(fig)
 
     env = estimate.envelope
@@ -136,7 +148,7 @@ def plot_workspace(
     ax.legend(loc="lower right")
     ax.grid(alpha=0.3)
     paths.append(out_dir / "workspace_section.png")
-    fig.savefig(paths[-1], dpi=110, bbox_inches="tight")
+    _save(fig, paths[-1])
     plt.close(fig)
     return paths
 

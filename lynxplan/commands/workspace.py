@@ -27,7 +27,12 @@ def register(subparsers: Any) -> None:
         help=f"smoke run: {QUICK_SAMPLES:,} samples (cannot be combined with --samples)",
     )
     parser.add_argument("--out", default="out/workspace", help="output folder")
-    parser.add_argument("--units", choices=tuple(LENGTH_UNITS), default="in", help="length unit")
+    parser.add_argument(
+        "--units",
+        choices=tuple(LENGTH_UNITS),
+        default="m",
+        help="length unit of what is printed and plotted (default m, as every command)",
+    )
     parser.add_argument("--cell", default="1", help="planar grid cell in mm (default 1)")
     parser.add_argument("--voxel", default="10", help="voxel edge in mm (default 10)")
     parser.add_argument("--seed", default="0", help="random seed, 0 <= seed < 2**63 (default 0)")
