@@ -43,7 +43,7 @@ def register(subparsers: Any) -> None:
 def add_robot_options(parser: argparse.ArgumentParser) -> None:
     """``--robot NAME`` / ``--urdf PATH --tool FRAME`` on a kinematics command."""
     group = parser.add_mutually_exclusive_group()
-    group.add_argument("--robot", help="built-in robot (al5, so100, so101); default: the AL5 arm")
+    group.add_argument("--robot", help="a built-in robot (see `lynxplan robots`); default: the AL5")
     group.add_argument("--urdf", help="URDF file of the robot (with --tool)")
     parser.add_argument("--tool", help="tool frame name (default: the robot's tool)")
 

@@ -53,7 +53,8 @@ def load_robot(
     package_dirs: list[str] | tuple[str, ...] | None = None,
     srdf: str | Path | None = None,
 ) -> Robot:
-    """A robot by built-in name (``al5``, ``so100``, ``so101``) or URDF path.
+    """A robot by built-in name (``al5``, ``so100``, ``so101``, ``ur5``, ``ur10``, ``panda``) or
+    URDF path.
 
     Args:
         name_or_urdf: Built-in name or path of a URDF file.

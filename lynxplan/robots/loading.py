@@ -1,8 +1,9 @@
 """Built-in robots and URDF loading: a fixed-base Pinocchio model of the arm chain and its tool.
 
-Built-ins: ``al5`` (the shipped URDF), ``so100`` and ``so101`` (from ``example_robot_data``,
-loaded with a fixed base, not the loader's free-flyer). Joints off the path from the base to the
-tool (a gripper's jaw) are locked at zero (clamped into their limits) and reported separately.
+Built-ins: ``al5`` (the shipped URDF); ``so100``, ``so101``, ``ur5``, ``ur10`` and ``panda``
+(from ``example_robot_data``, loaded with a fixed base, not the loader's free-flyer). Joints off
+the path from the base to the tool (a gripper's jaw) are locked at zero (clamped into their
+limits) and reported separately.
 
 SO-100 tool frame: the upstream model has none. lynxplan adds ``tool`` on the roll axis between
 the jaws: in the ``gripper`` link frame at (0, -0.1014, 0) m, i.e. midway between the closed jaws'
@@ -36,6 +37,7 @@ class BuiltinRobot:
         urdf: Path of its URDF.
         tool: Name of its tool frame.
         package_dirs: Folders that ``package://`` mesh URIs resolve against.
+        arm_joints: Joints of its arm chain (the gripper's locked joints not counted).
     """
 
     name: str
@@ -43,6 +45,7 @@ class BuiltinRobot:
     urdf: Path
     tool: str
     package_dirs: tuple[str, ...]
+    arm_joints: int = 5
 
 
 def _example_robot_data_dir() -> Path:
@@ -83,6 +86,30 @@ def builtin_robots() -> dict[str, BuiltinRobot]:
             robots / "so_arm_description" / "urdf" / "so101.urdf",
             "gripper_frame_link",
             packages,
+        ),
+        "ur5": BuiltinRobot(
+            "ur5",
+            "Universal Robots UR5 (example-robot-data), 6 joints; tool tool0",
+            robots / "ur_description" / "urdf" / "ur5_robot.urdf",
+            "tool0",
+            packages,
+            6,
+        ),
+        "ur10": BuiltinRobot(
+            "ur10",
+            "Universal Robots UR10 (example-robot-data), 6 joints; tool tool0",
+            robots / "ur_description" / "urdf" / "ur10_robot.urdf",
+            "tool0",
+            packages,
+            6,
+        ),
+        "panda": BuiltinRobot(
+            "panda",
+            "Franka Panda (example-robot-data), 7 joints, fingers locked; tool panda_hand_tcp",
+            robots / "panda_description" / "urdf" / "panda.urdf",
+            "panda_hand_tcp",
+            packages,
+            7,
         ),
     }
 

@@ -1,9 +1,9 @@
 """The robots the service knows, by built-in name only, and their public description.
 
-Over HTTP a robot is one of lynxplan's built-in robots (``al5``, ``so100``, ``so101``), named
-in the request; no name is ever taken for a path. A URDF of the caller's comes only with a run
-(:mod:`.uploads`), into that run's own folder. The AL5 is served by ``lynxplan.arm`` (its
-closed-form kernels); the others by ``lynxplan.load_robot``.
+Over HTTP a robot is one of lynxplan's built-in robots (``al5``, ``so100``, ``so101``, ``ur5``,
+``ur10``, ``panda``), named in the request; no name is ever taken for a path. A URDF of the
+caller's comes only with a run (:mod:`.uploads`), into that run's own folder. The AL5 is served
+by ``lynxplan.arm`` (its closed-form kernels); the others by ``lynxplan.load_robot``.
 """
 
 from __future__ import annotations
@@ -19,12 +19,19 @@ from lynxplan.service.problems import Problem
 NAME_ECHO = 40
 
 
+#: The built-in robots whose arm has five joints: the endpoints' arrays are (N, 5) today; the
+#: 6- and 7-joint built-ins (ur5, ur10, panda) are served through scenario runs only.
+SERVED_DOF = 5
+
+
 @functools.cache
 def robot_names() -> tuple[str, ...]:
-    """Names of the robots the service serves (lynxplan's built-ins)."""
+    """Names of the robots the service serves (lynxplan's 5-joint built-ins)."""
     from lynxplan.robots import builtin_robot_names
+    from lynxplan.robots.loading import builtin_robots
 
-    return tuple(sorted(builtin_robot_names()))
+    specs = builtin_robots()
+    return tuple(sorted(n for n in builtin_robot_names() if specs[n].arm_joints == SERVED_DOF))
 
 
 def check_robot_name(name: object, field: str = "robot") -> str:

@@ -18,7 +18,7 @@ def _json(capsys: pytest.CaptureFixture[str], argv: list[str]) -> object:
 
 def test_robots_lists_builtins(capsys: pytest.CaptureFixture[str]) -> None:
     names = [r["name"] for r in _json(capsys, ["robots", "--json"])]  # type: ignore[union-attr]
-    assert names == ["al5", "so100", "so101"]
+    assert names == ["al5", "so100", "so101", "ur5", "ur10", "panda"]
 
 
 def test_robot_info_shows_the_family(capsys: pytest.CaptureFixture[str]) -> None:
