@@ -7,20 +7,48 @@ about two minutes for the planner on a small machine.
 - :func:`compile_before_timing` compiles a kernel before a clock or a time limit starts.
 - :func:`enable_notices` (the CLI, when stderr is a terminal) and :func:`listen` (called by the
   modules of the big kernels once numba is imported: the CLI's light commands never import it)
-  print one line on stderr once compiling has taken :data:`NOTICE_AFTER` seconds.
+  print :data:`NOTICE` on stderr once compiling has taken :data:`NOTICE_AFTER` seconds. numba
+  reports a compile only when its cache had no version of the kernel for the argument types:
+  the notice never shows on a warm cache.
+- :func:`cold_kernels` tells, before anything runs, which of the big kernels
+  (:data:`ENTRY_KERNELS`) have no version in numba's cache for their current source: the pytest
+  plugin and ``lynxplan serve`` say :data:`NOTICE` up front when some do. ``lynxplan compile``
+  compiles them all.
 """
 
 from __future__ import annotations
 
+import importlib
 import sys
 import threading
 import time
+from collections.abc import Callable
 from typing import Any
 
 #: Seconds of compiling after which the wait is explained on stderr.
 NOTICE_AFTER = 3.0
 
-_state = {"notices": False, "listening": False}
+#: The one line that explains a first run's wait (times measured on 2 cores, cold cache).
+NOTICE = (
+    "lynxplan: compiling numba kernels for the first run (about 1-2 min on 2 cores, once; "
+    "`lynxplan compile` does it ahead)"
+)
+
+#: The big kernels ("module:name"), the ones whose compile the first runs wait for; inner
+#: kernels compile with them. :func:`cold_kernels` checks their cache entries.
+ENTRY_KERNELS = (
+    "lynxplan.arm.ik_kernel:ik_kernel",
+    "lynxplan.arm.ik_select:ik_single_kernel",
+    "lynxplan.robots.ik.family_kernel:family_ik_kernel",
+    "lynxplan.robots.ik.pose_kernel:pose_kernel",
+    "lynxplan.robots.ik.pose_block:pose_block_kernel",
+    "lynxplan.planning.rrt_connect:rrt_connect_begin",
+    "lynxplan.planning.rrt_connect:rrt_connect_kernel",
+    "lynxplan.planning.shortcut:shortcut_path",
+    "lynxplan.planning.certify:verification_rows",
+)
+
+_state = {"notices": False, "listening": False, "said": False}
 
 
 def compile_before_timing(kernel: Any, args: tuple[Any, ...]) -> float:
@@ -36,11 +64,52 @@ def compile_before_timing(kernel: Any, args: tuple[Any, ...]) -> float:
     return time.perf_counter() - began
 
 
+def cold_kernels(kernels: tuple[str, ...] = ENTRY_KERNELS) -> list[str]:
+    """The kernels among ``kernels`` ("module:name", numba dispatchers with ``cache=True``) that
+    have no compiled version in numba's on-disk cache for their current source file (its index
+    file, next to the source or under ``NUMBA_CACHE_DIR``, is missing, empty, from another numba
+    version, or older than the source). Imports their modules (and numba); reads one small index
+    file per kernel (a few ms in all)."""
+    cold = []
+    for kernel in kernels:
+        module, name = kernel.split(":")
+        dispatcher = getattr(importlib.import_module(module), name)
+        cache_file = getattr(getattr(dispatcher, "_cache", None), "_cache_file", None)
+        if cache_file is None or not cache_file._load_index():
+            cold.append(kernel)
+    return cold
+
+
+def announce_if_cold(
+    write: Callable[[str], None], kernels: tuple[str, ...] = ENTRY_KERNELS
+) -> bool:
+    """Say :data:`NOTICE` through ``write`` (once per process) when some of ``kernels`` are cold
+    (:func:`cold_kernels`); returns whether it said it. For the front ends that know ahead that
+    the big kernels are about to be used (the pytest plugin, ``lynxplan serve``)."""
+    if _state["said"] or not cold_kernels(kernels):
+        return False
+    _state["said"] = True
+    write(NOTICE)
+    return True
+
+
 def enable_notices() -> None:
     """From now on, announce long compiles on stderr (only when stderr is a terminal)."""
     _state["notices"] = sys.stderr.isatty()
     if "numba" in sys.modules:
         listen()
+
+
+def disable_notices() -> None:
+    """No notice from now on (``lynxplan compile`` shows a progress bar instead)."""
+    _state["notices"] = False
+
+
+def cache_folder(kernel: str = ENTRY_KERNELS[0]) -> str:
+    """The folder of numba's cache files for ``kernel``'s module (imports it)."""
+    module, name = kernel.split(":")
+    dispatcher = getattr(importlib.import_module(module), name)
+    return str(getattr(getattr(dispatcher, "_cache", None), "_cache_path", "(no cache)"))
 
 
 def listen() -> None:
@@ -90,9 +159,7 @@ class _Announcer:
 
     def _say(self) -> None:
         self.said = True
-        print(
-            "lynxplan: compiling numba kernels (once after installation; later runs load them "
-            "from numba's cache)...",
-            file=sys.stderr,
-            flush=True,
-        )
+        if not _state["notices"] or _state["said"]:
+            return
+        _state["said"] = True
+        print(NOTICE, file=sys.stderr, flush=True)

@@ -75,6 +75,7 @@ COMMAND_OF: dict[str, str] = {
     "serve": "lynxplan.commands.serve",
     "robots": "lynxplan.commands.robots",
     "robot": "lynxplan.commands.robots",
+    "compile": "lynxplan.commands.compile",
 }
 #: Every sub-command module, in the order of ``lynxplan --help``.
 COMMAND_MODULES = tuple(dict.fromkeys(COMMAND_OF.values()))

@@ -9,6 +9,7 @@ hold, or with the scenario error (file, key path, reason).
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Iterator
 from pathlib import Path
 from typing import Any
@@ -91,8 +92,41 @@ def pytest_collect_file(file_path: Path, parent: pytest.Collector) -> pytest.Col
     return ScenarioFile.from_parent(parent, path=file_path)
 
 
+#: Scenario kinds that run the big numba kernels (IK and planner): a cold cache makes their
+#: first run wait minutes (:data:`lynxplan._jit.NOTICE`).
+COMPILING_KINDS = frozenset({"task", "plan"})
+
+
+def pytest_collection_finish(session: pytest.Session) -> None:
+    """Say once, before the scenarios run, that numba compiles the kernels they use when its
+    cache has none of them (a first run after installation: minutes)."""
+    kinds = {
+        item.parent.kind
+        for item in session.items
+        if isinstance(item, ScenarioItem) and isinstance(item.parent, ScenarioFile)
+    }
+    if not kinds & COMPILING_KINDS:
+        return
+    from lynxplan import _jit
+
+    reporter = session.config.pluginmanager.get_plugin("terminalreporter")
+    if reporter is not None:
+        _jit.announce_if_cold(lambda line: reporter.write_line(line, yellow=True))
+    else:
+        _jit.announce_if_cold(lambda line: print(line, file=sys.stderr, flush=True))
+
+
 class ScenarioFile(pytest.File):
     """A scenario YAML file: one item."""
+
+    @property
+    def kind(self) -> Any:
+        """The scenario's ``kind:`` (None when the file cannot be read)."""
+        try:
+            data = yaml.safe_load(self.path.read_text(encoding="utf-8"))
+        except (OSError, UnicodeDecodeError, yaml.YAMLError):
+            return None
+        return data.get("kind") if isinstance(data, dict) else None
 
     def collect(self) -> Iterator[pytest.Item]:
         """The file's single scenario item."""

@@ -67,7 +67,7 @@ def _stderr_of_compiles(after: float) -> str:
 def test_a_long_compile_is_announced_once_on_a_terminal() -> None:
     said = _stderr_of_compiles(0.0)
     assert said.count("\n") == 1, said
-    assert said.startswith("lynxplan: compiling numba kernels (once after installation")
+    assert said.startswith("lynxplan: compiling numba kernels for the first run")
 
 
 def test_a_short_compile_says_nothing() -> None:

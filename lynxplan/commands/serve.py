@@ -125,6 +125,13 @@ def handle(args: argparse.Namespace) -> int:
         run_memory=int(args.run_memory * 1024**3),
     )  # fmt: skip
     _announce(args, config)
+    # numba's cache has none of the big kernels: say once (stderr, the log) that the workers'
+    # first runs compile them; checked in a thread while the server starts.
+    from threading import Thread
+
+    from lynxplan._jit import announce_if_cold
+
+    Thread(target=announce_if_cold, args=(_log_line,), daemon=True).start()
     uvicorn.run(
         create_app(config),
         host=args.host,
@@ -136,6 +143,12 @@ def handle(args: argparse.Namespace) -> int:
         limit_concurrency=args.max_connections,
     )
     return 0
+
+
+def _log_line(line: str) -> None:
+    import sys
+
+    print(line, file=sys.stderr, flush=True)
 
 
 def _announce(args: argparse.Namespace, config: Any) -> None:

@@ -1,0 +1,114 @@
+"""First runs say once that they compile; ``lynxplan compile`` compiles every kernel ahead.
+
+Each test uses its own empty numba cache (``NUMBA_CACHE_DIR``): the state after installation.
+"""
+
+from __future__ import annotations
+
+import os
+import pty
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from lynxplan import _jit
+from lynxplan.cli import COMMAND_OF
+
+ROOT = Path(__file__).resolve().parents[2]
+LYNXPLAN = str(Path(sys.executable).with_name("lynxplan"))
+P02 = ROOT / "scenarios" / "planning" / "p02_box_between.yaml"
+OK_TASK = ROOT / "scenarios" / "ok_task.yaml"
+PLAN_KIND = "lynxplan: compiling numba kernels for the first run"
+
+
+def _env(cache: Path) -> dict[str, str]:
+    return {**os.environ, "NUMBA_CACHE_DIR": str(cache)}
+
+
+def _on_a_terminal(command: list[str], cache: Path, timeout: float) -> tuple[int, str]:
+    """Run ``command`` with stderr on a pseudo-terminal (stdout piped); returns the exit code
+    and what the terminal received."""
+    main, other = pty.openpty()
+    try:
+        done = subprocess.run(
+            command, cwd=ROOT, env=_env(cache), stdout=subprocess.DEVNULL, stderr=other,
+            timeout=timeout, check=False,
+        )  # fmt: skip
+        os.close(other)
+        other = -1
+        said = b""
+        while True:
+            try:
+                chunk = os.read(main, 65536)
+            except OSError:  # EIO: the terminal is closed and read
+                break
+            if not chunk:
+                break
+            said += chunk
+    finally:
+        os.close(main)
+        if other >= 0:
+            os.close(other)
+    return done.returncode, said.decode(errors="replace")
+
+
+def _pytest(paths: list[Path], cache: Path, *options: str) -> str:
+    done = subprocess.run(
+        [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", "-q", *options,
+         *(str(p) for p in paths)],
+        cwd=ROOT, env=_env(cache), capture_output=True, text=True, timeout=1800, check=False,
+    )  # fmt: skip
+    assert done.returncode == 0, done.stdout[-3000:] + done.stderr[-3000:]
+    return done.stdout + done.stderr
+
+
+def test_compile_is_a_command() -> None:
+    assert COMMAND_OF["compile"] == "lynxplan.commands.compile"
+    done = subprocess.run([LYNXPLAN, "compile", "--help"], capture_output=True, text=True,
+                          timeout=60, check=True)  # fmt: skip
+    assert "numba" in done.stdout
+
+
+def test_cold_kernels_reads_the_cache_index_of_each_kernel(tmp_path: Path) -> None:
+    """Against an empty cache every big kernel is cold (numba's own cache dir for them)."""
+    script = "from lynxplan import _jit; print(len(_jit.cold_kernels()), _jit.cache_folder())"
+    done = subprocess.run([sys.executable, "-c", script], env=_env(tmp_path), capture_output=True,
+                          text=True, timeout=300, check=True)  # fmt: skip
+    count, folder = done.stdout.split()
+    assert int(count) == len(_jit.ENTRY_KERNELS)
+    assert folder.startswith(str(tmp_path))
+
+
+def test_pytest_plugin_says_once_that_it_compiles_on_an_empty_cache(tmp_path: Path) -> None:
+    said = _pytest([P02, OK_TASK], tmp_path, "--collect-only")
+    assert said.count(PLAN_KIND) == 1, said
+
+
+def test_pytest_plugin_says_nothing_for_kinds_without_big_kernels(tmp_path: Path) -> None:
+    said = _pytest([ROOT / "scenarios" / "parallel_ik.yaml"], tmp_path, "--collect-only")
+    assert PLAN_KIND not in said
+
+
+@pytest.mark.slow
+def test_first_run_says_it_compiles_and_none_after_lynxplan_compile(tmp_path: Path) -> None:
+    """The whole story on an empty cache (minutes: every kernel compiles, twice over)."""
+    code, said = _on_a_terminal([LYNXPLAN, "run", str(P02), "--quick", "--out",
+                                 str(tmp_path / "p02")], tmp_path / "cache", 3600)  # fmt: skip
+    assert code == 0
+    assert said.count(PLAN_KIND) == 1, said
+    done = subprocess.run([LYNXPLAN, "compile"], cwd=ROOT, env=_env(tmp_path / "cache"),
+                          capture_output=True, text=True, timeout=3600, check=False)  # fmt: skip
+    assert done.returncode == 0, done.stdout + done.stderr
+    assert "kernels compiled" in done.stdout
+    for scenario in (OK_TASK, P02):
+        out = str(tmp_path / scenario.stem)
+        command = [LYNXPLAN, "run", str(scenario), "--quick", "--out", out]
+        code, said = _on_a_terminal(command, tmp_path / "cache", 600)
+        assert code == 0
+        assert PLAN_KIND not in said, said
+    assert PLAN_KIND not in _pytest([P02, OK_TASK], tmp_path / "cache")
+    again = subprocess.run([LYNXPLAN, "compile"], cwd=ROOT, env=_env(tmp_path / "cache"),
+                           capture_output=True, text=True, timeout=900, check=False)  # fmt: skip
+    assert again.returncode == 0  # idempotent
