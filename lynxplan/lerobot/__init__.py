@@ -23,6 +23,9 @@ from lynxplan.lerobot.calibration import (
     read_calibration,
 )
 from lynxplan.lerobot.errors import CalibrationError, CalibrationWarning, FrameError, PlaybackError
+from lynxplan.lerobot.export import ServoFrames, read_csv, servo_frames, servo_frames_of, write_csv
+from lynxplan.lerobot.play import PlayReport, play
+from lynxplan.lerobot.track import LeRobotTrack, track_targets
 from lynxplan.lerobot.units import JointFrames, LeRobotUnits, lerobot_units
 
 __all__ = [
@@ -31,12 +34,21 @@ __all__ = [
     "CalibrationWarning",
     "FrameError",
     "JointFrames",
+    "LeRobotTrack",
     "LeRobotUnits",
     "MotorCalibration",
+    "PlayReport",
     "PlaybackError",
+    "ServoFrames",
     "calibrated_limits",
     "default_calibration_path",
     "lerobot_units",
     "load_calibrated",
+    "play",
     "read_calibration",
+    "read_csv",
+    "servo_frames",
+    "servo_frames_of",
+    "track_targets",
+    "write_csv",
 ]
