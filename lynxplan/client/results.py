@@ -54,6 +54,8 @@ class RunResult:
             timing=r["timing"],
             details=r["details"],
             summary=self.summary or "",
+            units=r.get("units", {"length": "m", "angle": "rad"}),
+            metric_quantities=r.get("metric_quantities", {}),
         )
 
 

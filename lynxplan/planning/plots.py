@@ -11,7 +11,12 @@ from lynxplan.units import length_factor
 
 
 def plot_clearance(
-    trajectory: Any, clearances: np.ndarray, out_path: Path, *, length_unit: str = "m"
+    trajectory: Any,
+    clearances: np.ndarray,
+    out_path: Path,
+    *,
+    length_unit: str = "m",
+    closest: tuple[str, str] | None = None,
 ) -> Path:
     """Exact smallest distance at every sample vs time, the required clearance as a line and the
     worst sample marked.
@@ -21,6 +26,8 @@ def plot_clearance(
         clearances: Exact smallest distance per sample, shape (N,), in [m].
         out_path: PNG file to write.
         length_unit: Unit of the vertical axis (``m``, ``mm``, ``in``).
+        closest: (link, obstacle) of the worst sample, for the title (default: the
+            verification's closest pair).
     """
     import matplotlib
 
@@ -44,8 +51,10 @@ def plot_clearance(
         color="tab:red",
         label=f"worst sample: {values[worst]:.4g} {length_unit} at {t[worst]:.3f} s",
     )
-    record = trajectory.verification.min_clearance
-    ax.set_title(f"clearance along the planned path (closest: {record.link} to {record.obstacle})")
+    if closest is None:
+        record = trajectory.verification.min_clearance
+        closest = (record.link, record.obstacle)
+    ax.set_title(f"clearance along the planned path (closest: {closest[0]} to {closest[1]})")
     ax.set_xlabel("time [s]")
     ax.set_ylabel(f"clearance [{length_unit}]")
     ax.set_ylim(bottom=0.0)

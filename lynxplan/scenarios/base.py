@@ -240,6 +240,15 @@ class Result:
         timing: Wall time of each stage and in total, in [s].
         details: Kind-specific tables (SI units).
         summary: One paragraph for stdout.
+        units: The scenario's own units (its ``units:`` block, e.g. ``{"length": "in",
+            "angle": "deg"}``); the metrics stay SI, :meth:`metric` and :meth:`metrics_in`
+            convert.
+        metric_quantities: Metric name -> its quantity (``length``, ``volume``, ``bool``...).
+
+    Reading a metric in the scenario's units: ``result.metric("min_clearance",
+    units="scenario")`` (e.g. inches for an inch file), or in any unit of its quantity:
+    ``result.metric("min_clearance", units="mm")``; every metric at once:
+    ``result.metrics_in("scenario")``; the unit a value is in: ``result.unit_of(name)``.
     """
 
     kind: str
@@ -252,6 +261,68 @@ class Result:
     timing: Mapping[str, float]
     details: Mapping[str, Any]
     summary: str
+    units: Mapping[str, str] = field(default_factory=lambda: dict(SI_UNITS))
+    metric_quantities: Mapping[str, str] = field(default_factory=dict)
+
+    def unit_of(self, name: str, units: str = "scenario") -> str:
+        """The unit :meth:`metric` gives ``name`` in: ``units`` is ``"si"``, ``"scenario"`` or
+        a unit of the metric's quantity (returned as is once checked); "" for a number without
+        a unit (counts, ratios, booleans).
+
+        Raises:
+            InputError: an unknown metric (naming the valid ones) or a unit that is not one of
+                the metric's quantity (naming the valid ones).
+        """
+        from lynxplan.exceptions import InputError
+        from lynxplan.scenarios.expect import QUANTITY_UNITS, default_unit
+
+        if name not in self.metrics:
+            raise InputError(
+                f"metric {name!r}: not a metric of this {self.kind} run; valid: "
+                + ", ".join(sorted(self.metrics))
+            )
+        quantity = self.metric_quantities.get(name, "")
+        table = QUANTITY_UNITS.get(quantity, {"": 1.0})
+        if units in ("si", "scenario"):
+            frame = Units(**self.units) if units == "scenario" else Units(length="m", angle="rad")
+            return default_unit(quantity, frame)
+        if units not in table:
+            valid = ", ".join(repr(u) for u in ("si", "scenario", *table) if u)
+            raise InputError(
+                f"metric {name!r} ({quantity or 'no unit'}): unknown unit {units!r}; valid: {valid}"
+            )
+        return units
+
+    def metric(self, name: str, units: str = "si") -> Any:
+        """A metric's value in ``units``.
+
+        Args:
+            name: The metric (a key of :attr:`metrics`).
+            units: ``"si"`` (m, rad, s: the value in :attr:`metrics`), ``"scenario"`` (the
+                scenario's ``units:`` block: ``in`` for a length of an inch file, ``in^3`` for
+                a volume, ``deg/s`` for an angular speed; seconds for times) or a unit of the
+                metric's quantity (``"mm"``, ``"deg"``, ``"in^3"``, ``"ms"``...).
+
+        Returns:
+            The value (a number, or nested lists for array metrics) in that unit; booleans,
+            counts, flags and unmeasured values (None, NaN) as they are.
+
+        Raises:
+            InputError: an unknown metric or unit (see :meth:`unit_of`).
+        """
+        from lynxplan.scenarios.expect import QUANTITY_UNITS
+
+        unit = self.unit_of(name, units)
+        factor = QUANTITY_UNITS.get(self.metric_quantities.get(name, ""), {}).get(unit, 1.0)
+        return _divided(self.metrics[name], factor)
+
+    def metrics_in(self, units: str = "scenario") -> dict[str, Any]:
+        """Every metric in ``units`` (``"si"`` or ``"scenario"``; see :meth:`metric`)."""
+        if units not in ("si", "scenario"):
+            from lynxplan.exceptions import InputError
+
+            raise InputError(f"metrics_in: units must be 'si' or 'scenario'. Got: {units!r}")
+        return {name: self.metric(name, units) for name in self.metrics}
 
     @property
     def ok(self) -> bool:
@@ -262,6 +333,20 @@ class Result:
     def failed_expectations(self) -> tuple[str, ...]:
         """Messages of the expectations that did not hold."""
         return tuple(e.message for e in self.expectations if not e.passed)
+
+
+def _divided(value: Any, factor: float) -> Any:
+    """``value`` (a number or nested lists/tuples of numbers) divided by ``factor``; booleans,
+    None, mappings and strings pass unchanged."""
+    if factor == 1.0 or value is None or isinstance(value, (bool, str, Mapping)):
+        return value
+    if isinstance(value, (list, tuple)):
+        return [_divided(v, factor) for v in value]
+    if hasattr(value, "tolist"):  # a numpy array or scalar
+        return _divided(value.tolist(), factor)
+    if isinstance(value, (int, float)):
+        return value / factor
+    return value
 
 
 class ScenarioKind(Protocol):

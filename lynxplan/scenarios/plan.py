@@ -35,9 +35,11 @@ goal in collision, or a goal out of reach, is an error naming the link, the obst
 penetration depth.
 
 Metrics: ``solved``, ``collision_free`` (exact verification passed), ``within_limits`` (joint
-position, velocity and acceleration limits at every sample), ``min_clearance`` [m] (smallest
-exact distance at the samples, the waypoints and the verification's probes; the planner
-certifies the required clearance on the continuous path), ``duration`` [s], ``path_length``
+position, velocity and acceleration limits at every sample), ``min_clearance`` [m]
+(:data:`lynxplan.scenarios.report.MIN_CLEARANCE_DEFINITION`: the smallest exact distance over the
+samples of the trajectory written to ``trajectory.csv``; the summary, ``details.min_clearance``
+and ``clearance.png`` show this same value; the planner certifies the required clearance on the
+continuous geometric path), ``duration`` [s], ``path_length``
 [rad] (joint space), ``nodes``, ``waypoints``, ``planning_time`` [s] (plan + shortcut + verify).
 Artifacts: ``trajectory.csv`` and, unless quick or switched off in ``outputs``,
 ``clearance.png`` and ``<name>.html``.
@@ -257,7 +259,6 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
 
     from lynxplan.exceptions import PlanningFailed
     from lynxplan.planning import Planner
-    from lynxplan.planning.verify import sample_clearances
 
     began = time.perf_counter()
     inputs = plan_inputs(scenario)
@@ -290,13 +291,12 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
         )
     solved = time.perf_counter()
     limits = limit_violations(trajectory, planner)
-    clearances = sample_clearances(planner.world, trajectory.q)
-    record = trajectory.verification.min_clearance
+    closest = min_clearance(planner.world, trajectory.t, trajectory.q)
     metrics = {
         "solved": True,
         "collision_free": trajectory.verification.collision_free,
         "within_limits": not limits,
-        "min_clearance": min(trajectory.min_clearance, float(clearances.min())),
+        "min_clearance": closest.clearance,
         "duration": trajectory.duration,
         "path_length": trajectory.path_length,
         "nodes": trajectory.stats.nodes,
@@ -307,13 +307,16 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
         f"plan {scenario.name}: solved with {trajectory.stats.nodes} nodes in "
         f"{trajectory.stats.solve_time * 1e3:.1f} ms (plan + shortcut + verify); "
         f"{len(trajectory.waypoints)} waypoints, {trajectory.path_length:.3f} rad, "
-        f"{trajectory.duration:.3f} s; min clearance {record.clearance * 1e3:.2f} mm "
-        f"({record.link} to {record.obstacle}); goal {trajectory.goal_label}"
+        f"{trajectory.duration:.3f} s; min clearance {closest.describe(scenario.units.length)}; "
+        f"goal {trajectory.goal_label}"
     )
     details = {
         "waypoints": trajectory.waypoints.tolist(),
         "goal": trajectory.goal_label,
-        "min_clearance": record._asdict(),
+        "min_clearance": closest.as_dict(),
+        # the verifier's smallest distance where it queried the geometric path: a different
+        # (coarser) quantity, not the metric; time is the path parameter (waypoint index)
+        "verification_probes_min_clearance": trajectory.verification.min_clearance._asdict(),
         "limit_violations": limits,
         "stats": {**trajectory.stats.__dict__, "solve_time": trajectory.stats.solve_time},
         "verification": {
@@ -326,7 +329,8 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
         "trajectory": trajectory,
         "robot": robot,
         "planner": planner,
-        "clearances": clearances,
+        "clearances": closest.per_sample,
+        "closest": closest,
     }
     stages = {
         "setup": built - began,
@@ -335,6 +339,63 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
         "clearance_profile": time.perf_counter() - solved,
     }
     return KindOutput(metrics, summary, details, payload=payload, stage_seconds=stages)
+
+
+@dataclass(frozen=True)
+class ClosestApproach:
+    """The ``min_clearance`` of a plan (:data:`~lynxplan.scenarios.report.
+    MIN_CLEARANCE_DEFINITION`), computed once and reported by the metric, the summary, the
+    details and the plot alike.
+
+    Attributes:
+        clearance: Smallest exact distance over the samples, in [m] (NaN: nothing to collide
+            with).
+        link: The robot link of the closest pair ("" when none).
+        obstacle: The obstacle (``self:<geometry>`` for a self pair; "" when none).
+        time: Time of the sample, in [s].
+        per_sample: The smallest distance at each sample, shape (N,), in [m].
+    """
+
+    clearance: float
+    link: str
+    obstacle: str
+    time: float
+    per_sample: np.ndarray
+
+    def as_dict(self) -> dict[str, Any]:
+        """``details.min_clearance`` of ``report.json`` (SI)."""
+        return {
+            "clearance": self.clearance,
+            "link": self.link,
+            "obstacle": self.obstacle,
+            "time": self.time,
+        }
+
+    def describe(self, length_unit: str) -> str:
+        """``6.983 mm (link_4 to wall at t = 1.23 s)``: in mm for metre files, else the file's
+        length unit."""
+        unit = "mm" if length_unit == "m" else length_unit
+        if not np.isfinite(self.clearance):
+            return "not measured (nothing to collide with)"
+        return (
+            f"{self.clearance / length_factor(unit):.4g} {unit} ({self.link} to {self.obstacle} "
+            f"at t = {self.time:.3f} s)"
+        )
+
+
+def min_clearance(world: Any, t: np.ndarray, q: np.ndarray) -> ClosestApproach:
+    """The plan's ``min_clearance``: exact (coal) smallest distance over every collision pair
+    at each sample q (N, nq) [rad] at times t (N,) [s], and where it is smallest."""
+    from lynxplan.planning.verify import verifier_of
+
+    distances, pairs = verifier_of(world).closest(np.asarray(q, dtype=float))
+    worst = int(np.argmin(distances))
+    if pairs[worst] < 0 or not np.isfinite(distances[worst]):
+        return ClosestApproach(float("nan"), "", "", float("nan"), distances)
+    link, _geometry, obstacle = world.pair_names(int(pairs[worst]))
+    return ClosestApproach(
+        float(distances[worst]), link, obstacle, float(np.asarray(t)[worst]), distances
+    )
 
 
 def limit_violations(trajectory: Any, planner: Any) -> list[str]:
@@ -383,10 +444,12 @@ def write_outputs(scenario: Input, output: KindOutput, out_dir: Path, *, quick: 
     if scenario.outputs.plots:
         from lynxplan.planning.plots import plot_clearance
 
+        closest = output.payload["closest"]
         plot_clearance(
             trajectory,
             output.payload["clearances"],
             out_dir / "clearance.png",
+            closest=(closest.link, closest.obstacle),
             length_unit="mm" if scenario.units.length == "m" else scenario.units.length,
         )
         written.append("clearance.png")

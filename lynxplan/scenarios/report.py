@@ -76,6 +76,27 @@ class _ExpectationModel(BaseModel):
     message: str
 
 
+#: What ``min_clearance`` is, for every kind that reports it (``task``, ``plan``): one quantity,
+#: computed once per run, the same in the metrics, the summary, ``details.min_clearance`` and
+#: the plots.
+MIN_CLEARANCE_DEFINITION = (
+    "Smallest exact distance (coal) between the robot's collision geometry and the obstacles "
+    "(and the robot's own links, for self pairs) over every sample of the run's trajectory (the "
+    "rows of trajectory.csv), in [m]; negative for a penetration; null when there is nothing "
+    "to collide with. details.min_clearance names the link, the obstacle and the time of that "
+    "sample."
+)
+
+
+class _MetricsModel(BaseModel):
+    """Measured values in SI units (m, rad, s); null where not measurable. The scenario's own
+    units are in ``units``, each metric's quantity in ``metric_quantities``."""
+
+    model_config = ConfigDict(extra="allow", title="Metrics")
+
+    min_clearance: float | None = Field(None, description=MIN_CLEARANCE_DEFINITION)
+
+
 class ReportModel(BaseModel):
     """Layout of ``report.json`` (published by ``lynxplan schema report``)."""
 
@@ -85,7 +106,7 @@ class ReportModel(BaseModel):
     schema_version: int = Field(ge=1, le=SCHEMA_VERSION, description="Version of this layout.")
     name: str = Field(description="Scenario name.")
     inputs: dict[str, Any] = Field(description="The scenario echoed, normalised to SI units.")
-    metrics: dict[str, Any] = Field(
+    metrics: _MetricsModel = Field(
         description="Measured values in SI units (m, rad, s); null where not measurable."
     )
     expectations: list[_ExpectationModel]
@@ -93,6 +114,16 @@ class ReportModel(BaseModel):
     timing: dict[str, float] = Field(description="Wall time of each stage and 'total', in [s].")
     details: dict[str, Any] = Field(description="Kind-specific tables, SI units.")
     passed: bool = Field(description="Every expectation held.")
+    units: dict[str, str] = Field(
+        default_factory=lambda: {"length": "m", "angle": "rad"},
+        description="The scenario's own units (its units: block). Inputs, metrics and details "
+        "are SI regardless; lynxplan.Result.metric(name, units='scenario') converts.",
+    )
+    metric_quantities: dict[str, str] = Field(
+        default_factory=dict,
+        description="Metric name -> its quantity (length, angle, time, volume, bool, ...): "
+        "the SI unit of each metric.",
+    )
 
 
 def report_schema() -> dict[str, Any]:
@@ -101,6 +132,7 @@ def report_schema() -> dict[str, Any]:
 
 
 __all__ = [
+    "MIN_CLEARANCE_DEFINITION",
     "ExpectationResult",
     "ReportModel",
     "dumps",

@@ -173,6 +173,8 @@ def _compute(loaded: LoadedScenario, staging: Path | None, *, quick: bool) -> Re
             timing={**timing, "total": time.perf_counter() - start},
             details=dict(output.details),
             summary=output.summary,
+            units=loaded.scenario.units.model_dump(),
+            metric_quantities=dict(type(loaded.scenario).metrics),
         )
 
     if staging is None:
