@@ -22,6 +22,10 @@ from lynxplan.commands._output import (
 from lynxplan.exceptions import InputError
 from lynxplan.units import angle_factor, length_factor
 
+CALIBRATION_HELP = (
+    "LeRobot calibration JSON of the arm (SO-100/SO-101): joint limits from its calibrated ranges"
+)
+
 
 def register(subparsers: Any) -> None:
     """Add the ``robots`` and ``robot`` sub-commands."""
@@ -35,6 +39,7 @@ def register(subparsers: Any) -> None:
     info = actions.add_parser("info", help="joints, limits, kinematic family, IK solver")
     info.add_argument("robot", metavar="NAME|URDF", help="built-in robot name or URDF path")
     info.add_argument("--tool", help="tool frame (default: the robot's tool)")
+    info.add_argument("--calibration", help=CALIBRATION_HELP)
     info.add_argument("--deg", action="store_true", help="limits in degrees (default radians)")
     info.add_argument("--json", action="store_true", help="print JSON")
     info.set_defaults(handler=handle_robot_info)
@@ -46,20 +51,40 @@ def add_robot_options(parser: argparse.ArgumentParser) -> None:
     group.add_argument("--robot", help="a built-in robot (see `lynxplan robots`); default: the AL5")
     group.add_argument("--urdf", help="URDF file of the robot (with --tool)")
     parser.add_argument("--tool", help="tool frame name (default: the robot's tool)")
+    parser.add_argument("--calibration", help=CALIBRATION_HELP)
 
 
 def wants_robot(args: argparse.Namespace) -> bool:
     """Whether a command was given a robot or a tool frame (then it runs through
     lynxplan.robots: a ``--tool`` of the AL5 is checked, never ignored)."""
     return bool(
-        getattr(args, "robot", None) or getattr(args, "urdf", None) or getattr(args, "tool", None)
+        getattr(args, "robot", None)
+        or getattr(args, "urdf", None)
+        or getattr(args, "tool", None)
+        or getattr(args, "calibration", None)
     )
 
 
 def _load(args: argparse.Namespace) -> Any:
+    return _load_robot(args.urdf or args.robot or "al5", args.tool, args.calibration)
+
+
+def _load_robot(name: str, tool: str | None, calibration: str | None) -> Any:
+    """load_robot; a LeRobot calibration's one-line warning (a range past the URDF's limits)
+    printed on stderr (the CLI silences library warnings)."""
+    import sys
+    import warnings
+
+    from lynxplan.lerobot.errors import CalibrationWarning
     from lynxplan.robots import load_robot
 
-    return load_robot(args.urdf or args.robot or "al5", tool=args.tool)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", CalibrationWarning)
+        robot = load_robot(name, tool=tool, calibration=calibration)
+    for warning in caught:
+        if issubclass(warning.category, CalibrationWarning):
+            print(f"warning: {warning.message}", file=sys.stderr)
+    return robot
 
 
 def handle_robots(args: argparse.Namespace) -> int:
@@ -109,11 +134,10 @@ def _info_dict(robot: Any, scale: float) -> dict[str, Any]:
 
 def handle_robot_info(args: argparse.Namespace) -> int:
     """Print joints, limits, the detected family and its parameters, and the IK solver."""
-    from lynxplan.robots import load_robot
 
     unit = "deg" if args.deg else "rad"
     scale = angle_factor(unit)
-    robot = load_robot(args.robot, tool=args.tool)
+    robot = _load_robot(args.robot, args.tool, args.calibration)
     data = _info_dict(robot, scale)
     if args.json:
         print_json({**data, "units": {"angle": unit, "velocity": "rad/s", "length": "m"}})

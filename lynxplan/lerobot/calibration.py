@@ -240,12 +240,14 @@ def load_calibrated(
     tool: str | None = None,
     base: Any = None,
     package_dirs: list[str] | tuple[str, ...] | None = None,
+    srdf: str | Path | None = None,
 ) -> Robot:
     """A robot (``"so101"``, ``"so100"`` or a URDF whose arm joints are named as LeRobot's
     motors) whose joint limits are the calibrated ranges of a LeRobot calibration.
 
     Warns (:class:`CalibrationWarning`, one line) when a calibrated range passes the URDF's
-    limits; the calibrated range is used.
+    limits; the calibrated range is used. ``tool``, ``base``, ``package_dirs``, ``srdf``: as
+    :func:`lynxplan.load_robot` (``load_robot(name, calibration=PATH)`` calls this).
 
     Raises:
         CalibrationError: unreadable calibration, or an arm joint without its motor.
@@ -255,7 +257,9 @@ def load_calibrated(
     from lynxplan.robots.robot import Robot
 
     cal = read_calibration(calibration)
-    loaded, builtin = load_model(name_or_urdf, tool=tool, base=base, package_dirs=package_dirs)
+    loaded, builtin = load_model(
+        name_or_urdf, tool=tool, base=base, package_dirs=package_dirs, srdf=srdf
+    )
     limits = calibrated_limits(Robot(loaded, builtin), cal)
     if limits.message is not None:
         warnings.warn(limits.message, CalibrationWarning, stacklevel=2)

@@ -52,6 +52,7 @@ def load_robot(
     base: Any = None,
     package_dirs: list[str] | tuple[str, ...] | None = None,
     srdf: str | Path | None = None,
+    calibration: str | Path | None = None,
 ) -> Robot:
     """A robot by built-in name (``al5``, ``so100``, ``so101``, ``ur5``, ``ur10``, ``panda``) or
     URDF path.
@@ -65,6 +66,8 @@ def load_robot(
             example-robot-data; see :mod:`lynxplan.mesh_paths`).
         srdf: SRDF whose ``disable_collisions`` pairs are not checked for self-collision.
             Default: ``<stem>.srdf`` next to the URDF or in ``../srdf/``, if there is one.
+        calibration: A LeRobot calibration file of the arm (SO-100/SO-101): joint limits from
+            its calibrated ranges (see :func:`lynxplan.lerobot.load_calibrated`).
 
     Raises:
         UnknownRobotError: neither a built-in name nor an existing file.
@@ -73,6 +76,12 @@ def load_robot(
     """
     from lynxplan.robots.loading import load_model
 
+    if calibration is not None:
+        from lynxplan.lerobot.calibration import load_calibrated
+
+        return load_calibrated(
+            name_or_urdf, calibration, tool=tool, base=base, package_dirs=package_dirs, srdf=srdf
+        )
     key = str(name_or_urdf)
     plain = tool is None and base is None and package_dirs is None and srdf is None
     if plain and key in _CACHE:
