@@ -16,7 +16,7 @@ import numpy as np
 
 from lynxplan import _jit
 from lynxplan.collision import CollisionWorld, Obstacle
-from lynxplan.exceptions import InputError, PlanningFailed
+from lynxplan.exceptions import InputError, PlanningFailed, ShapeError
 from lynxplan.planning.certify import verification_rows
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
@@ -91,6 +91,15 @@ class PlannerOptions:
             raise InputError(
                 f"planner option timing must be one of {', '.join(METHODS)}. Got: {self.timing!r}"
             )
+
+
+def _per_joint_option(name: str, value: Any, nq: int) -> np.ndarray:
+    """A planner option given as a scalar or one value per joint, as (nq,) floats."""
+    array = np.asarray(value, dtype=float)
+    if array.shape not in ((), (nq,)):
+        raise ShapeError(f"planner option {name}", f"() or ({nq},)", array.shape)
+    out: np.ndarray = np.broadcast_to(array, (nq,)).copy()
+    return out
 
 
 @dataclass(frozen=True)
@@ -197,10 +206,8 @@ class Planner:
         self.verifier = verifier_of(self.world)
         nq = self.space.dimension
         self.velocity = np.array(robot.limits.velocity, dtype=float)
-        self.acceleration = np.broadcast_to(
-            np.asarray(self.options.max_acceleration, dtype=float), (nq,)
-        ).copy()
-        self.jerk = np.broadcast_to(np.asarray(self.options.max_jerk, dtype=float), (nq,)).copy()
+        self.acceleration = _per_joint_option("max_acceleration", self.options.max_acceleration, nq)
+        self.jerk = _per_joint_option("max_jerk", self.options.max_jerk, nq)
         for name, limit in (("acceleration", self.acceleration), ("jerk", self.jerk)):
             if not (np.isfinite(limit).all() and (limit > 0).all()):
                 raise InputError(f"planner option max_{name} must be positive: {limit.tolist()}")

@@ -22,10 +22,11 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.exceptions import InputError, RetimingError
 from lynxplan.trajectory.lspb import unit_lspb
 from lynxplan.trajectory.ruckig_samples import ruckig_states
-from lynxplan.trajectory.timing import auto_timing_linear
+from lynxplan.trajectory.timing import auto_timing_linear, samples_implied
 
 METHODS = ("ruckig", "lspb", "toppra")
 #: Default sample rate of the time-parameterised trajectory, in [Hz].
@@ -123,7 +124,8 @@ def _toppra_law(
 def _times(duration: float, rate: float) -> np.ndarray:
     """Equally spaced sample times from 0 to ``duration`` [s], both included, at least ``rate``
     [Hz]: np.linspace's values (its step times the index, the last exactly ``duration``),
-    without its overhead."""
+    without its overhead. ResourceLimitError beyond the sample limit, before allocating."""
+    guards.check_size("trajectory samples (duration x rate)", samples_implied(duration, rate), 8.0)
     count = max(2, math.ceil(duration * rate - 1e-9) + 1)
     t = np.arange(count) * (duration / (count - 1))
     t[-1] = duration
@@ -180,6 +182,7 @@ def time_parameterize(
         counts.append(len(s))
         offset += float(t[-1])
     # every sample at once: its segment's start plus s, s' and s'' times the segment
+    guards.check_size("trajectory samples (duration x rate)", sum(counts) + 1, 8.0)
     segment = np.repeat(np.asarray(segments, dtype=np.int64), counts)
     step = deltas[segment]
     rest = np.zeros((1, path.shape[1]))

@@ -45,7 +45,9 @@ def create_app(config: ServiceConfig) -> ASGIApp:
         )  # fmt: skip
         get_robot("al5")  # load the model (and JIT caches) before the first request
         compute.ik_batch_arrays(np.eye(4)[None])
+        compute_pool.start()  # warm in the background: /health answers meanwhile
         yield
+        compute_pool.close()
         state.pop("runs").close()
 
     app = FastAPI(
@@ -88,7 +90,7 @@ def create_app(config: ServiceConfig) -> ASGIApp:
     async def robot(name: str) -> Response:
         return wire.json_response(describe_robot(name))
 
-    add_kinematics_routes(app, config, runs)
+    compute_pool = add_kinematics_routes(app, config, runs)
     add_run_routes(app, config, runs)
 
     # -- web page ----------------------------------------

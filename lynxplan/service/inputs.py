@@ -154,3 +154,53 @@ def motion_limits(body: dict[str, Any], arm: Any) -> Any:
         values.get("acceleration", base.acceleration),
         values.get("jerk", base.jerk),
     )
+
+
+#: Ranges of the numeric /plan options a request may set (PlannerOptions fields): bounded so
+#: that no option alone makes the planner allocate without bound (the node budget, the step
+#: that sizes the trees' blocks) or sample without bound (the rate).
+PLAN_OPTION_RANGES: dict[str, tuple[float, float]] = {
+    "clearance": (0.0, 1.0),
+    "step": (1e-4, 10.0),
+    "goal_bias": (0.0, 0.99),
+    "max_nodes": (2, 1_000_000),
+    "shortcut_iterations": (0, 100_000),
+    "shortcut_patience": (1, 100_000),
+    "sample_rate": (1.0, 10_000.0),
+}
+#: /plan options given as a number or one number per joint, > 0.
+PLAN_PER_JOINT_OPTIONS = ("max_acceleration", "max_jerk")
+_INTEGER_OPTIONS = ("max_nodes", "shortcut_iterations", "shortcut_patience")
+
+
+def plan_options(body: dict[str, Any], dof: int) -> dict[str, Any]:
+    """The ``options`` object of /plan, checked (422 naming ``options.<name>``): known names,
+    numbers within :data:`PLAN_OPTION_RANGES`, per-joint limits as a number or ``dof``
+    positive numbers, ``timing`` one of ruckig, lspb, toppra."""
+    given = body.get("options") or {}
+    if not isinstance(given, dict):
+        raise Problem(422, "options must be an object", "options")
+    known = (*PLAN_OPTION_RANGES, *PLAN_PER_JOINT_OPTIONS, "timing")
+    options: dict[str, Any] = {}
+    for name, value in given.items():
+        field = f"options.{name}"
+        if name not in known:
+            raise Problem(
+                422, f"unknown option {str(name)[:40]!r}; options: {', '.join(known)}", "options"
+            )
+        if name == "timing":
+            options[name] = choice({field: value}, field, ("ruckig", "lspb", "toppra"))
+        elif name in PLAN_PER_JOINT_OPTIONS:
+            shape = (dof,) if isinstance(value, list) else ()
+            array = as_array(value, field, shape, batch=False)
+            if (array <= 0).any():
+                raise Problem(422, f"{field} must be positive", field)
+            # as_array makes a 0-d value (1,): a number stays a number
+            options[name] = float(array.ravel()[0]) if shape == () else tuple(array.tolist())
+        else:
+            low, high = PLAN_OPTION_RANGES[name]
+            number_value = number({field: value}, field, low, low, high)
+            if name in _INTEGER_OPTIONS and not isinstance(value, int):
+                raise Problem(422, f"{field} must be an integer. Got: {value!r}"[:120], field)
+            options[name] = int(number_value) if name in _INTEGER_OPTIONS else number_value
+    return options

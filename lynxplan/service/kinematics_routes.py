@@ -12,12 +12,13 @@ import numpy as np
 from fastapi import FastAPI, Request
 from starlette.responses import HTMLResponse, Response
 
-from lynxplan.service import compute, inputs, wire
+from lynxplan.service import compute, inputs, sizes, wire
 from lynxplan.service.config import ServiceConfig
 from lynxplan.service.jobs import RunManager
 from lynxplan.service.problems import Problem
 from lynxplan.service.robots import get_robot, is_al5, robot_ik_batch_arrays
 from lynxplan.service.schemas import openapi_body
+from lynxplan.service.workers import ComputePool
 
 #: Batches at least this large are solved off the event loop (or on Dask when configured).
 THREAD_BATCH = 2_000
@@ -25,9 +26,20 @@ THREAD_BATCH = 2_000
 
 def add_kinematics_routes(
     app: FastAPI, config: ServiceConfig, runs: Callable[[], RunManager]
-) -> None:
-    """Add ``/fk``, ``/ik``, ``/check``, ``/trajectory``, ``/plan`` and ``/view`` to ``app``."""
+) -> ComputePool:
+    """Add ``/fk``, ``/ik``, ``/check``, ``/trajectory``, ``/plan`` and ``/view`` to ``app``.
+
+    Returns:
+        The compute pool that runs /check, /trajectory, /plan and /view (the caller starts it
+        with the server and closes it after).
+    """
     view_lock = asyncio.Lock()
+    pool = ComputePool(
+        getattr(config, "compute_workers", 2), config.run_memory, compute.MAX_REQUEST_TIME
+    )
+
+    def answer_kind(request: Request) -> str:
+        return "binary" if wire.wants_binary(request) else "json"
 
     async def json_body(request: Request) -> dict[str, Any]:
         return wire.parse_json_object(await wire.read_body(request, config.max_body))
@@ -51,6 +63,8 @@ def add_kinematics_routes(
         if q_value is None:
             raise Problem(422, "q is required: joint angles (5,) or (N, 5) in rad", "q")
         q = wire.as_array(q_value, "q", (5,), limit=batch_limit(request))
+        count = len(q) if q.ndim == 2 else 1
+        sizes.check_answer(config, "q", count, sizes.FK_POSE_BYTES[answer_kind(request)], "poses")
         result = await _maybe_threaded(len(q) if q.ndim == 2 else 1, compute.fk_arrays, arm, q)
         if wire.wants_binary(request):
             return wire.arrays_response(
@@ -85,6 +99,7 @@ def add_kinematics_routes(
             )
             return wire.json_response(_ik_single_json(result, residual))
         reference = inputs.reference(body, len(T))
+        sizes.check_answer(config, "T", len(T), sizes.IK_POSE_BYTES[answer_kind(request)], "poses")
         scalars: dict[str, Any] = {"count": len(T)}
         if is_al5(arm):
             arrays = await _ik_batch(runs(), config, T, reference, only_approach, verify)
@@ -100,24 +115,28 @@ def add_kinematics_routes(
         response.headers["Server-Timing"] = f"app;dur={1e3 * (time.perf_counter() - start):.3f}"
         return response
 
-    # -- collision and trajectories ----------------------------------------
+    # -- collision, trajectories, plans: sizes checked here, computed by the compute pool ----
     @app.post("/check", tags=["collision"], openapi_extra=openapi_body("CheckRequest"))
     async def check(request: Request) -> Response:
         body = await json_body(request)
-        arm = get_robot(inputs.robot_name(body))
+        name = inputs.robot_name(body)
+        get_robot(name)
         q = wire.as_array(body.get("q"), "q", (5,), limit=config.max_json_batch)
         t = None if body.get("t") is None else wire.as_array(body["t"], "t", (), batch=True)
         if t is not None and t.shape != (len(q.reshape(-1, 5)),):
             raise Problem(422, f"t must have shape ({len(q.reshape(-1, 5))},). Got: {t.shape}", "t")
-        obstacles = _obstacles(body)
-        self_collision = inputs.flag(body, "self_collision")
-        result = await asyncio.to_thread(compute.check_arrays, arm, q, t, obstacles, self_collision)
-        return wire.json_response(result)
+        specs = inputs.obstacle_specs(body)
+        sizes.check_pairs(config, len(q.reshape(-1, 5)), len(specs))
+        _obstacles(body)  # a bad obstacle is a 422 here, before a worker is asked
+        content = await pool.call(request, "check", robot=name, q=q, t=t, obstacles=specs,
+                                  self_collision=inputs.flag(body, "self_collision"))  # fmt: skip
+        return Response(content, media_type="application/json")
 
     @app.post("/trajectory", tags=["trajectory"], openapi_extra=openapi_body("TrajectoryRequest"))
     async def trajectory(request: Request) -> Response:
         body = await json_body(request)
-        arm = get_robot(inputs.robot_name(body))
+        name = inputs.robot_name(body)
+        arm = get_robot(name)
         waypoints = wire.as_array(body.get("waypoints"), "waypoints", (5,), limit=1000)
         if waypoints.ndim != 2 or len(waypoints) < 2:
             raise Problem(
@@ -127,48 +146,102 @@ def add_kinematics_routes(
         rate = inputs.number(body, "rate", 100.0, 1.0, 10_000.0)
         timing = _timing(body) if method == "lspb" else None
         limits = inputs.motion_limits(body, arm)
-        profiles = await asyncio.to_thread(
-            compute.trajectory_profiles, arm, waypoints, method, rate, limits, timing
-        )
-        return wire.json_response(
-            {
-                "method": method,
-                "duration": float(sum(p.t[-1] for p in profiles)),
-                "segments": [p._asdict() for p in profiles],
-            }
-        )
+        _check_trajectory_samples(config, body, arm, waypoints, limits, rate, timing)
+        content = await pool.call(
+            request, "trajectory", robot=name, waypoints=waypoints, method=method, rate=rate,
+            limits=limits, timing=timing, max_samples=sizes.sample_limit(config),
+            size_field="rate",
+        )  # fmt: skip
+        return Response(content, media_type="application/json")
 
     @app.post("/plan", tags=["planning"], openapi_extra=openapi_body("PlanRequest"))
     async def plan(request: Request) -> Response:
         body = await json_body(request)
-        arm = get_robot(inputs.robot_name(body))
+        name = inputs.robot_name(body)
+        arm = get_robot(name)
         start = wire.as_array(body.get("start"), "start", (5,), batch=False)
         goal_value = body.get("goal")
         goal_shape = (4, 4) if isinstance(goal_value, list) and goal_value and isinstance(
             goal_value[0], list) else (5,)  # fmt: skip
         goal = wire.as_array(goal_value, "goal", goal_shape, batch=False)
-        obstacles = _obstacles(body)
+        _obstacles(body)
         seed = int(inputs.number(body, "seed", 0, 0, 2**31 - 1))
         budget = inputs.number(body, "time_limit", 1.0, 1e-3, compute.MAX_PLAN_TIME)
-        options = body.get("options") or {}
-        if not isinstance(options, dict):
-            raise Problem(422, "options must be an object", "options")
-        try:
-            result = await asyncio.to_thread(
-                compute.plan_json, arm, start, goal, obstacles, seed, budget, options
-            )
-        except TypeError as exc:  # an unknown option name
-            raise Problem(422, f"options: {exc}".split(".__init__()")[-1], "options") from None
-        return wire.json_response(result)
+        options = inputs.plan_options(body, 5)
+        if goal.shape == (5,):  # a joint goal: the motion's samples are bounded from below
+            _check_plan_samples(config, arm, start, goal, options)
+        content = await pool.call(
+            request, "plan", robot=name, start=start, goal=goal,
+            obstacles=inputs.obstacle_specs(body), seed=seed, time_limit=budget,
+            options=options, max_samples=sizes.sample_limit(config), size_field="options",
+        )  # fmt: skip
+        return Response(content, media_type="application/json")
 
     @app.post("/view", tags=["kinematics"], openapi_extra=openapi_body("FkRequest"))
     async def view(request: Request) -> Response:
         body = await json_body(request)
-        arm = get_robot(inputs.robot_name(body))
+        name = inputs.robot_name(body)
+        get_robot(name)
         q = wire.as_array(body.get("q"), "q", (5,), batch=False)
         async with view_lock:  # one meshcat server process at a time
-            html = await asyncio.to_thread(compute.view_html, arm, q)
+            html = await pool.call(request, "view", robot=name, q=q)
         return HTMLResponse(html)
+
+    return pool
+
+
+def _check_trajectory_samples(
+    config: ServiceConfig,
+    body: dict[str, Any],
+    arm: Any,
+    waypoints: np.ndarray,
+    limits: Any,
+    rate: float,
+    timing: tuple[float, float] | None,
+) -> None:
+    """413 before any work when the /trajectory motion implies more samples than the limit."""
+    from lynxplan.trajectory import MotionLimits
+
+    base = MotionLimits.from_joint_limits(arm.limits)
+    given = body.get("limits") or {}
+    values = {
+        "timing.tt": None if timing is None else timing[0],
+        "limits.velocity": limits.velocity,
+        "limits.acceleration": limits.acceleration,
+        "rate": rate,
+    }
+    defaults: dict[str, Any] = {} if timing is None else {"timing.tt": None}
+    defaults.update({f"limits.{k}": getattr(base, k) for k in ("velocity", "acceleration")
+                     if k in given})  # fmt: skip
+
+    def count(v: dict[str, Any]) -> tuple[float, float]:
+        return sizes.motion_samples(waypoints, v["limits.velocity"], v["limits.acceleration"],
+                                    v["rate"], v["timing.tt"])  # fmt: skip
+
+    sizes.check_samples(config, count, values, defaults, "rate")
+
+
+def _check_plan_samples(
+    config: ServiceConfig, arm: Any, start: np.ndarray, goal: np.ndarray, options: dict[str, Any]
+) -> None:
+    """413 before planning when the direct motion from ``start`` to the joint ``goal`` (a lower
+    bound of any path's) already implies more samples than the limit."""
+    from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE
+    from lynxplan.trajectory.limits import DEFAULT_MAX_ACCELERATION
+
+    ends = np.stack([start, goal])
+    values = {
+        "options.max_acceleration": options.get("max_acceleration", DEFAULT_MAX_ACCELERATION),
+        "options.sample_rate": options.get("sample_rate", DEFAULT_SAMPLE_RATE),
+    }
+    defaults = {"options.max_acceleration": DEFAULT_MAX_ACCELERATION} if (
+        "max_acceleration" in options) else {}  # fmt: skip
+
+    def count(v: dict[str, Any]) -> tuple[float, float]:
+        return sizes.motion_samples(ends, arm.limits.velocity, v["options.max_acceleration"],
+                                    v["options.sample_rate"])  # fmt: skip
+
+    sizes.check_samples(config, count, values, defaults, "options.sample_rate")
 
 
 async def _maybe_threaded(count: int, function: Any, *args: Any) -> Any:

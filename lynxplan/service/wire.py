@@ -12,6 +12,7 @@ element, and JSON answers serialise numpy arrays directly (``OPT_SERIALIZE_NUMPY
 from __future__ import annotations
 
 import io
+import math
 import zipfile
 from collections.abc import Mapping
 from typing import Any
@@ -76,29 +77,89 @@ def parse_json_object(body: bytes) -> dict[str, Any]:
 
 
 def decode_binary(request: Request, body: bytes, field: str) -> np.ndarray:
-    """The array of a binary body (npy or raw float64 + ``X-Shape``), as float64."""
+    """The array of a binary body (npy or raw float64 + ``X-Shape``), as float64.
+
+    The shape a header declares is checked against the body's length with Python integers
+    (no int64 product that wraps) before any array is made: nothing is allocated beyond the
+    body itself and its float64 copy.
+    """
     if media_type(request) == NPY_MEDIA_TYPE:
-        try:
-            array = np.load(io.BytesIO(body), allow_pickle=False)
-        except (ValueError, OSError, EOFError) as exc:
-            raise Problem(422, f"invalid .npy body: {exc}", field) from None
-        if not isinstance(array, np.ndarray) or array.dtype.kind not in "iuf":
-            raise Problem(422, f"the .npy array must be numeric. Got: {array.dtype}", field)
-        return np.ascontiguousarray(array, dtype=np.float64)
+        return _decode_npy(body, field)
     shape_header = request.headers.get("x-shape")
     if shape_header is None:
         raise Problem(422, "raw float64 bodies need an X-Shape header, e.g. '100,4,4'", "X-Shape")
-    try:
-        shape = tuple(int(part) for part in shape_header.split(","))
-    except ValueError:
+    parts = shape_header.split(",")
+    digits = [p.strip() for p in parts]
+    if (
+        len(shape_header) > 80
+        or len(parts) > MAX_DIMENSIONS
+        or not all(d.isascii() and d.isdigit() for d in digits)
+    ):
         raise Problem(
-            422, f"X-Shape must be integers separated by commas. Got: {shape_header!r}", "X-Shape"
-        ) from None
-    if any(n < 0 for n in shape) or len(body) != 8 * int(np.prod(shape, dtype=np.int64)):
+            422,
+            f"X-Shape must be at most {MAX_DIMENSIONS} non-negative integers separated by commas."
+            f" Got: {shape_header[:60]!r}",
+            "X-Shape",
+        )
+    shape = tuple(int(d) for d in digits)
+    elements = math.prod(shape)  # a Python int: exact for any header
+    if 8 * elements != len(body):
         raise Problem(
-            422, f"body of {len(body)} bytes does not hold float64 of shape {shape}", "X-Shape"
+            422,
+            f"X-Shape {_shape_text(shape)} declares {_count(elements)} float64 values "
+            f"({_count(8 * elements)} bytes); the body has {len(body)} bytes",
+            "X-Shape",
         )
     return np.frombuffer(body, dtype="<f8").reshape(shape)
+
+
+#: Most dimensions a binary array may declare (the routes take at most 3).
+MAX_DIMENSIONS = 4
+
+
+def _decode_npy(body: bytes, field: str) -> np.ndarray:
+    """The array of a ``.npy`` body: header read and checked against the body's length first
+    (a header may declare any shape), never unpickled."""
+    from numpy.lib import format as npy
+
+    stream = io.BytesIO(body)
+    try:
+        version = npy.read_magic(stream)
+        if version == (1, 0):
+            shape, fortran, dtype = npy.read_array_header_1_0(stream)
+        elif version in ((2, 0), (3, 0)):
+            shape, fortran, dtype = npy.read_array_header_2_0(stream)
+        else:
+            raise ValueError(f"unsupported .npy version {version}")
+    except (ValueError, OSError, EOFError, SyntaxError) as exc:
+        reason = " ".join(str(exc).split())[:120]
+        raise Problem(422, f"invalid .npy body: {reason}", field) from None
+    if dtype.kind not in "iuf" or dtype.hasobject:
+        raise Problem(422, f"the .npy array must be numeric. Got: {dtype}", field)
+    if len(shape) > MAX_DIMENSIONS:
+        dims = f"{len(shape)} dimensions; at most {MAX_DIMENSIONS}"
+        raise Problem(422, f"the .npy array has {dims}", field)
+    elements = math.prod(shape)
+    offset = stream.tell()
+    if elements * dtype.itemsize != len(body) - offset:
+        raise Problem(
+            422,
+            f"the .npy header declares shape {_shape_text(shape)} ({_count(elements)} values of "
+            f"{dtype.itemsize} bytes); the body holds {len(body) - offset} bytes of data",
+            field,
+        )
+    flat = np.frombuffer(body, dtype=dtype, count=elements, offset=offset)
+    array = flat.reshape(shape, order="F" if fortran else "C")
+    return np.ascontiguousarray(array, dtype=np.float64)
+
+
+def _shape_text(shape: tuple[int, ...]) -> str:
+    text = "(" + ", ".join(map(str, shape)) + ("," if len(shape) == 1 else "") + ")"
+    return text if len(text) <= 80 else text[:77] + "..."
+
+
+def _count(n: int) -> str:
+    return str(n) if n < 10**12 else f"{float(n):.3g}"
 
 
 def as_array(
@@ -124,6 +185,8 @@ def as_array(
         batch and array.ndim == len(trailing) + 1 and array.shape[1:] == trailing
     ):
         raise Problem(422, f"{field} must have shape {expected}. Got: {array.shape}", field)
+    if not single and array.shape[0] == 0:
+        raise Problem(422, f"{field} is an empty batch: give at least one {trailing} entry", field)
     if limit and not single and array.shape[0] > limit:
         raise Problem(
             413, f"{field}: batch of {array.shape[0]} exceeds the limit of {limit}", field

@@ -27,6 +27,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from lynxplan import guards
 from lynxplan.constants import LIMIT_CHECK_RELATIVE_TOLERANCE, LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import RetimingError
 from lynxplan.trajectory.free import FreeSegment
@@ -35,7 +36,7 @@ from lynxplan.trajectory.line import LineSegment
 from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import DEFAULT_SAMPLE_RATE, Plan
 from lynxplan.trajectory.ruckig_samples import ruckig_states
-from lynxplan.trajectory.timing import auto_timing_linear, auto_timing_path
+from lynxplan.trajectory.timing import auto_timing_linear, auto_timing_path, samples_implied
 
 METHODS = ("lspb", "lspb_auto", "ruckig", "ruckig_lspb_duration", "toppra")
 #: Methods whose jerk is bounded by construction (the others' sampled jerk is impulsive).
@@ -102,7 +103,12 @@ class ProfileStats(NamedTuple):
 
 
 def sample_times(duration: float, rate: float) -> np.ndarray:
-    """Times 0, 1/rate, ... and the duration itself, shape (N,), in [s]."""
+    """Times 0, 1/rate, ... and the duration itself, shape (N,), in [s].
+
+    Raises:
+        ResourceLimitError: more samples than the resource limit (checked before allocating).
+    """
+    guards.check_size("trajectory samples (duration x rate)", samples_implied(duration, rate), 8.0)
     count = math.floor(duration * rate + 1e-9) + 1
     t = np.arange(count) / rate
     return t if t[-1] >= duration - 1e-12 else np.append(t, duration)

@@ -142,3 +142,40 @@ def auto_timing_path(
         return stationary_timing()
     big_t = tt / (1.0 + rho)
     return LspbTiming(tt, min(rho * big_t, 0.5 * tt))
+
+
+def min_rest_to_rest_duration(
+    delta: np.ndarray, max_velocity: np.ndarray, max_acceleration: np.ndarray
+) -> float:
+    """A lower bound on the duration of any rest-to-rest motion by ``delta`` under the limits,
+    in [s]: the slowest joint's own bang-coast-bang time (``2 sqrt(D/a)``, or ``D/v + v/a``
+    when it reaches ``v``). Synchronising the joints (LSPB, ruckig, toppra), a jerk limit or
+    rests at intermediate waypoints only lengthen a motion, so no timing method is shorter.
+
+    Computed with Python floats from validated positive limits: it never raises, and is
+    ``inf`` where the time overflows (e.g. an acceleration limit of 1e-300), so a caller can
+    bound the samples a request implies before anything is allocated.
+
+    Args:
+        delta: Change per joint, shape (n,), in [rad].
+        max_velocity: Speed limit per joint, shape (n,) or scalar, > 0, in [rad/s].
+        max_acceleration: Acceleration limit per joint, shape (n,) or scalar, > 0, in [rad/s^2].
+    """
+    d = np.abs(np.asarray(delta, dtype=float)).ravel()
+    v = np.broadcast_to(np.asarray(max_velocity, dtype=float), d.shape)
+    a = np.broadcast_to(np.asarray(max_acceleration, dtype=float), d.shape)
+    longest = 0.0
+    for dj, vj, aj in zip(d.tolist(), v.tolist(), a.tolist(), strict=True):
+        if dj == 0.0:
+            continue
+        cruise = vj * vj / aj  # distance needed to reach vj and stop again
+        time = 2.0 * math.sqrt(dj / aj) if dj <= cruise else dj / vj + vj / aj
+        longest = max(longest, time)
+    return longest
+
+
+def samples_implied(duration: float, rate: float) -> float:
+    """Samples of a motion of ``duration`` [s] sampled at ``rate`` [Hz], both ends included
+    (a bound of :func:`lynxplan.trajectory.retime.sample_times`'s count): a float, ``inf``
+    when it overflows, computed before anything is allocated."""
+    return math.floor(duration * rate) + 2.0 if math.isfinite(duration * rate) else math.inf

@@ -1,0 +1,206 @@
+"""Hostile sizes and malformed binary input against a real ``lynxplan serve`` process (issue 35,
+sections 1 and 4): every size a request implies is refused (413/422 naming the field, the size
+and the limit) before anything is allocated, never a 500; the heavier routes run in the compute
+workers, which are killed when their client disconnects; and the server process's peak RSS,
+read from /proc, stays within a bound through all of it (no address-space cap is set)."""
+
+from __future__ import annotations
+
+import io
+import json
+import socket
+import time
+from pathlib import Path
+from typing import Any
+
+import httpx
+import numpy as np
+import pytest
+from service_server import Server
+
+#: Most the server process's resident set may grow (VmHWM over the RSS before the first hostile
+#: request) through these tests, in [bytes]; the README documents it. Without the size checks a
+#: single request below asks for terabytes.
+PEAK_GROWTH_BOUND = 200 * 1024**2
+
+START = [0.0, 0.0, 0.0, 0.0, 0.0]
+GOAL = [0.5, 0.5, -0.5, 0.5, 0.5]
+RAW = {"Content-Type": "application/octet-stream"}
+
+
+def _status(pid: int) -> dict[str, int]:
+    """VmRSS and VmHWM of process ``pid``, in [bytes]."""
+    fields = {}
+    for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+        key, _, value = line.partition(":")
+        if key in ("VmRSS", "VmHWM"):
+            fields[key] = int(value.split()[0]) * 1024
+    return fields
+
+
+@pytest.fixture(scope="module")
+def baseline(server: Server) -> int:
+    """The server's RSS before the first hostile request, its peak reset to it."""
+    pid = server.process.pid
+    Path(f"/proc/{pid}/clear_refs").write_text("5")  # reset VmHWM to the current RSS
+    return _status(pid)["VmRSS"]
+
+
+def _npy_header(shape: tuple[int, ...]) -> bytes:
+    buffer = io.BytesIO()
+    header = {"descr": "<f8", "fortran_order": False, "shape": shape}
+    np.lib.format.write_array_header_1_0(buffer, header)
+    return buffer.getvalue()
+
+
+def _pose(q: list[float]) -> list[list[float]]:
+    from lynxplan.arm.model import load_arm
+
+    pose: list[list[float]] = load_arm().fk(np.array(q)).tolist()
+    return pose
+
+
+def _case(
+    name: str, path: str, status: int, field: str, text: str, **arguments: Any
+) -> tuple[str, str, dict[str, Any], int, str, str]:
+    return name, path, arguments, status, field, text
+
+
+def _raw(shape: str | bytes, body: bytes = b"") -> dict[str, Any]:
+    return {"content": body, "headers": {**RAW, "X-Shape": shape}}
+
+
+def _hostile() -> list[tuple[str, str, dict[str, Any], int, str, str]]:
+    """(id, path, httpx arguments, status, field, text in the detail)."""
+    sphere = {"type": "sphere", "centre": [0.3, 0.3, 0.3], "radius": 0.01}
+    configs = np.round(np.random.default_rng(0).uniform(-1, 1, (1000, 5)), 3).tolist()
+    npy = {"Content-Type": "application/x-npy"}
+    far = {"waypoints": [[0.5, 0.5, -0.5, 0.5, 0.5], [1, 1, -1, 1, 1]], "rate": 10000}
+    move = {"start": START, "goal": GOAL}
+    return [
+        # section 4: malformed binary headers (were 500)
+        _case("xshape-wraps", "/ik", 422, "X-Shape", "2305843009213693952",
+              **_raw("2305843009213693952,4,4")),
+        _case("xshape-overflow", "/ik", 422, "X-Shape", "99999999999999999999999",
+              **_raw("99999999999999999999999,4,4")),
+        _case("xshape-empty-fk", "/fk", 422, "q", "empty batch", **_raw("0,5")),
+        _case("npy-header-1e13", "/ik", 422, "T", "10000000000000",
+              content=_npy_header((10**13, 4, 4)) + bytes(128), headers=npy),
+        _case("xshape-not-ascii-digits", "/fk", 422, "X-Shape", "integers",
+              **_raw("1,5,\u00b2".encode("latin-1"), bytes(40))),
+        # section 4: hostile numbers (were 500)
+        _case("toppra-acceleration-1e-300", "/trajectory", 413, "limits.acceleration",
+              "samples", json={"waypoints": [START, GOAL], "method": "toppra",
+                               "limits": {"acceleration": 1e-300}}),
+        _case("plan-max-jerk-2", "/plan", 422, "options.max_jerk", "(5,)",
+              json={**move, "options": {"max_jerk": [1, 2]}}),
+        _case("plan-max-acceleration-3", "/plan", 422, "options.max_acceleration", "(5,)",
+              json={**move, "options": {"max_acceleration": [1, 2, 3]}}),
+        # section 1: sizes (samples = duration x rate on the time law's grid, pairs)
+        _case("trajectory-velocity-1e-7", "/trajectory", 413, "limits.velocity",
+              "5e+10 samples", json={**far, "limits": {"velocity": 1e-7}}),
+        _case("trajectory-fixed-hour", "/trajectory", 413, "timing.tt", "3.6e+07 samples",
+              json={"waypoints": [START, GOAL], "rate": 10000, "timing": {"tt": 3600, "ta": 1}}),
+        _case("plan-acceleration-1e-12", "/plan", 413, "options.max_acceleration", "samples",
+              json={**move, "options": {"max_acceleration": 1e-12}}),
+        _case("plan-pose-goal-acceleration-1e-12", "/plan", 413, "options",
+              "trajectory samples",
+              json={"start": START, "goal": _pose(GOAL), "options": {"max_acceleration": 1e-12}}),
+        _case("plan-sample-rate-1e12", "/plan", 422, "options.sample_rate", "10000",
+              json={**move, "options": {"sample_rate": 1e12}}),
+        _case("plan-step-tiny", "/plan", 422, "options.step", "within",
+              json={**move, "options": {"step": 1e-12}}),
+        _case("check-pairs", "/check", 413, "obstacles", "2001000 distance queries",
+              json={"q": configs, "obstacles": [sphere] * 2001}),
+    ]  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("path", "arguments", "status", "field", "text"),
+    [case[1:] for case in _hostile()],
+    ids=[case[0] for case in _hostile()],
+)
+def test_hostile_size_is_refused_naming_the_field(
+    http: httpx.Client, baseline: int, path: str, arguments: dict[str, Any], status: int,
+    field: str, text: str,
+) -> None:  # fmt: skip
+    response = http.post(path, **arguments)
+    assert response.status_code == status, response.text
+    problem = response.json()
+    assert problem["field"] == field
+    assert text in problem["detail"]
+    assert "\n" not in problem["detail"]
+
+
+def test_size_refusal_names_size_and_limit(http: httpx.Client, baseline: int) -> None:
+    body = {"waypoints": [[0.5, 0.5, -0.5, 0.5, 0.5], [1, 1, -1, 1, 1]], "rate": 10000,
+            "limits": {"velocity": 1e-7}}  # fmt: skip
+    detail = http.post("/trajectory", json=body).json()["detail"]
+    # 0.5 rad at 1e-7 rad/s: 5e6 s of cruise (the acceleration phases add 1e-8 s) at 10 kHz
+    assert "5e+10 samples (5e+06 s or more at 10000 Hz)" in detail
+    assert "more than the limit of " in detail
+
+
+def test_allowed_requests_still_work_in_the_compute_workers(
+    http: httpx.Client, baseline: int
+) -> None:
+    rng = np.random.default_rng(1)
+    spheres = [{"type": "sphere", "centre": rng.uniform(-0.3, 0.3, 3).tolist(), "radius": 0.01}
+               for _ in range(100)]  # fmt: skip
+    q = rng.uniform(-1, 1, (1000, 5))
+    answer = http.post("/check", json={"q": q.tolist(), "obstacles": spheres})
+    assert answer.status_code == 200, answer.text
+    assert np.asarray(answer.json()["clearance"]).shape == (1000, 100)
+    trajectory = http.post("/trajectory", json={"waypoints": [START, GOAL], "rate": 1000})
+    assert trajectory.status_code == 200, trajectory.text
+    t = np.asarray(trajectory.json()["segments"][0]["t"])
+    # LSPB auto-timing of 0.5 rad on every joint (SPEC Part 2), limits from /robots/al5 and the
+    # default 8 rad/s^2: V = max 0.5 / v_j, A = 0.5 / 8; tt = 2 sqrt(A) or V + A / V
+    velocity = np.array([j["velocity"] for j in http.get("/robots/al5").json()["joints"]])
+    big_v, big_a = float(np.max(0.5 / velocity)), 0.5 / 8.0
+    tt = 2 * np.sqrt(big_a) if big_v <= np.sqrt(big_a) else big_v + big_a / big_v
+    assert t[-1] == pytest.approx(tt, rel=1e-12)
+    assert len(t) == np.ceil(tt * 1000 - 1e-9) + 1  # 1 ms apart, the end included
+    assert np.diff(t).max() == pytest.approx(1e-3, rel=1e-9)
+    options = {"max_acceleration": [8, 8, 8, 8, 8]}
+    planned = http.post("/plan", json={"start": START, "goal": GOAL, "options": options})
+    assert planned.status_code == 200, planned.text
+
+
+def _children(pid: int) -> set[int]:
+    found = set()
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        if int(fields[1]) == pid:
+            found.add(int(stat.parent.name))
+    return found
+
+
+def test_disconnect_kills_the_computation(server: Server, baseline: int) -> None:
+    """A client that hangs up during a long /trajectory (999 toppra segments, ~10-40 s of work)
+    has its compute worker killed and replaced; the server keeps answering."""
+    before = _children(server.process.pid)
+    rng = np.random.default_rng(2)
+    body = json.dumps({"waypoints": rng.uniform(-0.5, 0.5, (1000, 5)).tolist(),
+                       "method": "toppra"}).encode()  # fmt: skip
+    with socket.create_connection(("127.0.0.1", server.port)) as sock:
+        sock.sendall(
+            f"POST /trajectory HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\n"
+            f"Content-Length: {len(body)}\r\n\r\n".encode()
+            + body
+        )
+        time.sleep(1.0)  # the request reaches a worker
+    deadline = time.monotonic() + 60
+    while before <= _children(server.process.pid) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not before <= _children(server.process.pid), "no worker was killed"
+    assert httpx.get(f"{server.url}/health", timeout=30).status_code == 200
+
+
+def test_peak_rss_stays_bounded(server: Server, baseline: int) -> None:
+    """Last in this file: the server's peak RSS through every request above."""
+    peak = _status(server.process.pid)["VmHWM"]
+    assert peak - baseline < PEAK_GROWTH_BOUND, (peak, baseline)
