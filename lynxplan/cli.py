@@ -222,6 +222,23 @@ def main(argv: Sequence[str] | None = None) -> int:
         gc.freeze()  # the process exits next: no final traversal of the start-up's objects
 
 
+def _show_lynxplan_warnings() -> None:
+    """lynxplan's own warnings (a length implausible for the robot) as one line on stderr each,
+    also when library warnings are silenced (call inside ``warnings.catch_warnings``)."""
+    from lynxplan.units import ImplausibleLengthWarning
+
+    warnings.simplefilter("always", ImplausibleLengthWarning)
+    default = warnings.showwarning
+
+    def show(message: Any, category: Any, *args: Any, **kwargs: Any) -> None:
+        if issubclass(category, ImplausibleLengthWarning):
+            sys.stderr.write(f"lynxplan: warning: {_one_line(str(message))}\n")
+        else:
+            default(message, category, *args, **kwargs)
+
+    warnings.showwarning = show
+
+
 def _command(argv: Sequence[str]) -> str | None:
     """The sub-command named by ``argv`` (global options removed), or None."""
     try:
@@ -244,6 +261,7 @@ def _main(argv: Sequence[str]) -> int:
         with guards.raised_limits(max_samples=limit), warnings.catch_warnings():
             if not debug:  # library warnings (numpy, Pinocchio) would break the one-line rule
                 warnings.simplefilter("ignore")
+            _show_lynxplan_warnings()
             code: int = args.handler(args)
         return code
     except LynxplanError as exc:

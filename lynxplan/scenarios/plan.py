@@ -238,11 +238,18 @@ class PlanInputs:
 
 
 def plan_inputs(scenario: Input) -> PlanInputs:
-    """The planner inputs of a scenario (loads the robot: the AL5 or any URDF robot)."""
+    """The planner inputs of a scenario (loads the robot: the AL5 or any URDF robot); warns
+    about lengths implausible for the robot (:func:`warn_implausible_lengths`)."""
+    from lynxplan.scenarios.plausible import warn_implausible_lengths
     from lynxplan.scenarios.robot import load_robot_entry
 
+    robot = load_robot_entry(scenario.robot)
+    goal = scenario.goal
+    target = goal.position if goal.pose is None else [row[3] for row in goal.pose[:3]]
+    targets = [] if target is None else [("goal", target)]
+    warn_implausible_lengths(robot, scenario.units.length, scenario.obstacles, targets)
     return PlanInputs(
-        load_robot_entry(scenario.robot),
+        robot,
         _obstacles(scenario),
         np.array(scenario.start) * angle_factor(scenario.units.angle),
         _goal(scenario),
