@@ -75,6 +75,10 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--max-upload", type=float, default=32.0,
                         help="largest total of the files uploaded with a run [MiB]")  # fmt: skip
     parser.add_argument("--max-batch", type=int, default=1_000_000, help="largest batch")
+    parser.add_argument("--max-answer", type=float, default=256.0,
+                        help="largest answer a request may imply, checked first [MiB]")  # fmt: skip
+    parser.add_argument("--compute-workers", type=int, default=2,
+                        help="processes computing /check, /trajectory, /plan")  # fmt: skip
     parser.add_argument("--header-timeout", type=float, default=10.0,
                         help="time a request head may take [s]")  # fmt: skip
     parser.add_argument("--body-timeout", type=float, default=30.0,
@@ -99,13 +103,14 @@ def handle(args: argparse.Namespace) -> int:
             f"binding to {args.host} requires --token-file (only loopback may "
             "serve without a token)"
         )
-    if args.workers < 1 or not 0 < args.port < 65536:
-        raise InputError("--workers must be >= 1 and --port within 1..65535")
+    if args.workers < 1 or args.compute_workers < 1 or not 0 < args.port < 65536:
+        raise InputError("--workers and --compute-workers must be >= 1 and --port within 1..65535")
     if args.max_connections < 1:
         raise InputError(f"--max-connections must be >= 1. Got: {args.max_connections}")
     for option, value in (
         ("--max-body", args.max_body),
         ("--max-upload", args.max_upload),
+        ("--max-answer", args.max_answer),
         ("--run-memory", args.run_memory),
         ("--run-timeout", args.run_timeout),
         ("--header-timeout", args.header_timeout),
@@ -121,6 +126,7 @@ def handle(args: argparse.Namespace) -> int:
         cors_origins=tuple(args.cors_origin),
         max_body=int(args.max_body * 1024**2), max_batch=args.max_batch,
         max_upload=int(args.max_upload * 1024**2),
+        max_answer=int(args.max_answer * 1024**2), compute_workers=args.compute_workers,
         dask_scheduler=args.dask_scheduler, run_timeout=args.run_timeout,
         run_memory=int(args.run_memory * 1024**3),
     )  # fmt: skip

@@ -30,6 +30,10 @@ class ServiceConfig:
         run_memory: Address-space limit of a run worker, in [bytes] (0: none).
         max_scenario: Largest scenario text, in [bytes].
         max_upload: Largest total of the files uploaded with one run (URDF, meshes), in [bytes].
+        compute_workers: Worker processes computing /check, /trajectory, /plan and /view
+            (each limited to ``run_memory``).
+        max_answer: Largest answer, in [bytes]: the sizes a request implies (poses, samples,
+            clearances) are checked against it before anything is computed.
     """
 
     data_dir: Path
@@ -47,3 +51,5 @@ class ServiceConfig:
     run_memory: int = 8 * 1024**3
     max_scenario: int = 1024**2
     max_upload: int = 32 * 1024**2
+    compute_workers: int = 2
+    max_answer: int = 256 * 1024**2

@@ -34,9 +34,7 @@ def add_kinematics_routes(
         with the server and closes it after).
     """
     view_lock = asyncio.Lock()
-    pool = ComputePool(
-        getattr(config, "compute_workers", 2), config.run_memory, compute.MAX_REQUEST_TIME
-    )
+    pool = ComputePool(config.compute_workers, config.run_memory, compute.MAX_REQUEST_TIME)
 
     def answer_kind(request: Request) -> str:
         return "binary" if wire.wants_binary(request) else "json"

@@ -42,7 +42,7 @@ def sample_limit(config: ServiceConfig) -> int:
 
 def max_answer(config: ServiceConfig) -> int:
     """Largest answer, in [bytes]."""
-    return int(getattr(config, "max_answer", 256 * 1024**2))
+    return config.max_answer
 
 
 def _mb(n: float) -> str:

@@ -204,3 +204,28 @@ def test_peak_rss_stays_bounded(server: Server, baseline: int) -> None:
     """Last in this file: the server's peak RSS through every request above."""
     peak = _status(server.process.pid)["VmHWM"]
     assert peak - baseline < PEAK_GROWTH_BOUND, (peak, baseline)
+
+
+def test_answer_limit_refuses_before_computing(tmp_path: Path) -> None:
+    """A server with 1 MiB answers: the poses, samples and clearances a request implies are
+    refused by their estimated answer bytes (413 naming the field, the size and the limit)."""
+    small = Server(tmp_path / "data", "--max-answer", "1", "--compute-workers", "1")
+    try:
+        with httpx.Client(base_url=small.url, timeout=120.0) as client:
+            q = np.zeros((3000, 5))  # 3000 poses x 16 numbers as JSON: ~1.2 MB
+            fk = client.post("/fk", json={"q": q.tolist()})
+            assert fk.status_code == 413, fk.text
+            assert fk.json()["field"] == "q" and "3000 poses" in fk.json()["detail"]
+            assert client.post("/fk", json={"q": q[:2000].tolist()}).status_code == 200
+            T = np.broadcast_to(np.eye(4), (1000, 4, 4))  # ~1.85 MB of all-branch answers
+            ik = client.post("/ik", json={"T": T.tolist()})
+            assert ik.status_code == 413 and ik.json()["field"] == "T", ik.text
+            # 1 MiB / 400 bytes a sample: 2621 samples; 1 rad in >= 0.5 s at 10 kHz is more
+            move = {"waypoints": [START, [1.0] * 5], "rate": 10000}
+            trajectory = client.post("/trajectory", json=move)
+            assert trajectory.status_code == 413, trajectory.text
+            assert trajectory.json()["field"] == "rate"
+            assert "more than the limit of 2621" in trajectory.json()["detail"]
+            assert client.post("/trajectory", json={**move, "rate": 100}).status_code == 200
+    finally:
+        small.stop()
