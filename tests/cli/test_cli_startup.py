@@ -32,7 +32,7 @@ def test_version_is_printed_on_stdout(capsys) -> None:
 def test_fk_loads_none_of_the_heavy_modules() -> None:
     code = (
         "import sys; from lynxplan.cli import main; "
-        "code = main(['fk', '0.1', '0.2', '0.3', '0.4', '0.5']); "
+        "code = main(['fk', '0.1', '0.2', '-0.3', '0.4', '0.5']); "
         f"print(sorted(m for m in {NOT_FOR_FK!r} if m in sys.modules)); sys.exit(code)"
     )
     done = subprocess.run(
