@@ -76,6 +76,8 @@ def _targets(robot: Robot, given: dict[str, Any]) -> tuple[dict[str, np.ndarray]
     lead = arrays.get("poses", arrays.get("positions"))
     assert lead is not None
     n = int(lead.shape[0]) if lead.ndim > 1 else 0
+    if "approaches" in arrays and arrays["approaches"].shape == (3,):  # one for every target
+        arrays["approaches"] = np.broadcast_to(arrays["approaches"], (n, 3))
     for name, array in arrays.items():
         if array.ndim == 0 or array.shape[0] != n:
             raise InputError(f"{name}: {n} targets expected (the first axis). Got: {array.shape}")
@@ -136,7 +138,8 @@ def track_targets(
         robot: The model (:func:`~lynxplan.lerobot.load_calibrated` for the arm's own limits).
         units: Its LeRobot units (:func:`~lynxplan.lerobot.lerobot_units`).
         poses / positions + approaches / pitches, rolls: N targets as in ``Robot.ik_batch``
-            (positions [m], pitches and rolls [rad]).
+            (positions [m], pitches and rolls [rad]); one approach, shape (3,), applies to
+            every target.
         gripper: Gripper channel per target, shape (N,) or scalar, 0..100.
         start: The arm's configuration before the first frame: a LeRobot observation dict or
             shape (n,) [rad]. Default: zeros within the limits.
