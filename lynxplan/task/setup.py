@@ -79,6 +79,7 @@ def _resolve(scenario: Scenario) -> TaskSetup:
     arm, kinematics = load_path_robot(scenario.robot)
     limits = _limits(scenario, arm, angle)
     obstacles = tuple(_obstacles(scenario, length, angle))
+    _warn_implausible(scenario, arm)
     waypoints = {
         name: _waypoint(name, entry, arm, length, angle)
         for name, entry in scenario.waypoints.items()
@@ -149,6 +150,19 @@ def _rotation(entry: BoxEntry | CylinderEntry, angle: float) -> np.ndarray | Non
     if entry.rotation is not None:
         return np.array(entry.rotation, dtype=float)
     return None
+
+
+def _warn_implausible(scenario: Scenario, arm: Any) -> None:
+    """One warning when an obstacle or a waypoint's tool point is implausibly far for the arm
+    (a file in mm read as metres), as for ``plan`` scenarios."""
+    from lynxplan.scenarios.plausible import warn_implausible_lengths
+
+    targets = []
+    for name, entry in scenario.waypoints.items():
+        point = entry.position if entry.pose is None else [row[3] for row in entry.pose[:3]]
+        if point is not None:
+            targets.append((f"waypoints.{name}", point))
+    warn_implausible_lengths(arm, scenario.units.length, scenario.obstacles, targets)
 
 
 def _obstacles(scenario: Scenario, length: float, angle: float) -> list[Obstacle]:

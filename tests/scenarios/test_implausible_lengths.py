@@ -52,3 +52,25 @@ def test_library_warns_and_plausible_files_do_not() -> None:
     with warnings.catch_warnings():
         warnings.simplefilter("error", ImplausibleLengthWarning)
         lynxplan.run_scenario(WINDOW)  # the shipped file: no warning
+
+
+def test_task_scenarios_warn_too() -> None:
+    """The OK task with its obstacles written in thousandths of an inch while the file says
+    inches: the task kind warns as the plan kind does (the run may then fail on its own terms)."""
+    task = yaml.safe_load((WINDOW.parents[1] / "ok_task.yaml").read_text())
+    assert task["units"]["length"] == "in"
+    for obstacle in task["obstacles"]:
+        obstacle["min_corner"] = [v * 1000 for v in obstacle["min_corner"]]
+    import contextlib
+
+    # the warning comes before the run can fail on the lengths
+    with (
+        contextlib.suppress(lynxplan.LynxplanError),
+        pytest.warns(ImplausibleLengthWarning, match=r"obstacles\[0\]\.min_corner: "),
+    ):
+        lynxplan.run_scenario(task, quick=True)
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", ImplausibleLengthWarning)
+        lynxplan.run_scenario(WINDOW.parents[1] / "ok_task.yaml", quick=True)  # no warning
