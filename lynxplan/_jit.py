@@ -28,10 +28,12 @@ from typing import Any
 #: Seconds of compiling after which the wait is explained on stderr.
 NOTICE_AFTER = 3.0
 
-#: The one line that explains a first run's wait (times measured on 2 cores, cold cache).
+#: The one line that explains a first run's wait. Measured from an empty cache (numba compiles
+#: on one core): the AL5's IK and planner kernels ~2.5 min of CPU, the SO-101's IK ~3.5 min more,
+#: ``lynxplan compile`` 6.2 min of CPU in all.
 NOTICE = (
-    "lynxplan: compiling numba kernels for the first run (about 1-2 min on 2 cores, once; "
-    "`lynxplan compile` does it ahead)"
+    "lynxplan: compiling numba kernels for the first run (about 2-6 min on 2 cores, once; "
+    "`lynxplan compile` compiles them all ahead)"
 )
 
 #: The big kernels ("module:name"), the ones whose compile the first runs wait for; inner

@@ -22,6 +22,8 @@ from lynxplan import _jit
 _WALL = {"name": "wall", "type": "box", "centre": [0.0, 0.25, 0.04], "size": [0.12, 0.12, 0.26]}
 _TABLE = {"name": "table", "type": "box", "centre": [0.0, 0.1, -0.105], "size": [0.9, 0.7, 0.03]}
 _CHECKS = {"collision_free": True, "within_limits": True}
+#: What the shipped plan scenarios check (the clearance and duration metrics run kernels too).
+_PLAN_CHECKS = {**_CHECKS, "solved": True, "min_clearance": ">= 1 mm", "max_duration": "<= 60 s"}
 
 #: Small scenarios, one per kind and robot: their runs compile the kernels the kinds use.
 SCENARIOS: dict[str, dict[str, Any]] = {
@@ -35,6 +37,7 @@ SCENARIOS: dict[str, dict[str, Any]] = {
         "kind": "plan", "units": {"length": "m", "angle": "deg"}, "robot": {},
         "obstacles": [_TABLE, _WALL], "start": [30, 45, -70, 90, 0],
         "goal": {"q": [150, 45, -70, 90, 0]}, "planner": {"seed": 0, "time_limit": 30.0},
+        "expect": _PLAN_CHECKS,
     },
     "plan (SO-101)": {
         "kind": "plan", "units": {"length": "m", "angle": "deg"}, "robot": {"name": "so101"},
@@ -45,7 +48,7 @@ SCENARIOS: dict[str, dict[str, Any]] = {
         ],
         "start": [38.9, 4.3, 5.4, 80.3, -90],
         "goal": {"position": [0.2, 0.12, 0.05], "approach": [0, 0, -1]},
-        "planner": {"seed": 0, "time_limit": 30.0},
+        "planner": {"seed": 0, "time_limit": 30.0}, "expect": _PLAN_CHECKS,
     },
     "task (AL5)": {
         "kind": "task", "units": {"length": "in", "angle": "deg"}, "robot": {},

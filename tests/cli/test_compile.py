@@ -9,6 +9,7 @@ import os
 import pty
 import subprocess
 import sys
+import threading
 from pathlib import Path
 
 import pytest
@@ -28,30 +29,33 @@ def _env(cache: Path) -> dict[str, str]:
 
 
 def _on_a_terminal(command: list[str], cache: Path, timeout: float) -> tuple[int, str]:
-    """Run ``command`` with stderr on a pseudo-terminal (stdout piped); returns the exit code
-    and what the terminal received."""
+    """Run ``command`` with stderr on a pseudo-terminal (stdout discarded), read as it comes (a
+    full terminal would block the writer); returns the exit code and what the terminal got."""
     main, other = pty.openpty()
+    chunks: list[bytes] = []
+
+    def read() -> None:
+        while True:
+            try:
+                chunk = os.read(main, 65536)
+            except OSError:  # EIO: the writer's side is closed
+                return
+            if not chunk:
+                return
+            chunks.append(chunk)
+
+    reader = threading.Thread(target=read, daemon=True)
+    reader.start()
     try:
         done = subprocess.run(
             command, cwd=ROOT, env=_env(cache), stdout=subprocess.DEVNULL, stderr=other,
             timeout=timeout, check=False,
         )  # fmt: skip
-        os.close(other)
-        other = -1
-        said = b""
-        while True:
-            try:
-                chunk = os.read(main, 65536)
-            except OSError:  # EIO: the terminal is closed and read
-                break
-            if not chunk:
-                break
-            said += chunk
     finally:
+        os.close(other)
+        reader.join(timeout=30)
         os.close(main)
-        if other >= 0:
-            os.close(other)
-    return done.returncode, said.decode(errors="replace")
+    return done.returncode, b"".join(chunks).decode(errors="replace")
 
 
 def _pytest(paths: list[Path], cache: Path, *options: str) -> str:
