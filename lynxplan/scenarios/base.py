@@ -19,9 +19,35 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Annotated, Any, ClassVar, Literal, Protocol
+from typing import Annotated, Any, ClassVar, Protocol
 
-from pydantic import BaseModel, ConfigDict, Field, model_validator
+from pydantic import Field, model_validator
+
+from lynxplan.scenarios.expect import ExpectationResult, parse_expectations
+from lynxplan.scenarios.quantities import Quantity, StrictModel, Units
+
+__all__ = [
+    "SCHEMA_VERSION",
+    "SI_UNITS",
+    "ExpectationResult",
+    "Finite",
+    "KindOutput",
+    "Matrix3",
+    "Positive",
+    "Quantity",
+    "Result",
+    "RobotRef",
+    "ScenarioKind",
+    "ScenarioModel",
+    "StrictModel",
+    "TargetEntry",
+    "Units",
+    "Vector3",
+    "check_target_form",
+    "located_error",
+    "scale_translation",
+    "scaled",
+]
 
 #: Version of the ``report.json`` layout (:class:`Result`); bumped on incompatible changes.
 SCHEMA_VERSION = 1
@@ -31,20 +57,6 @@ Finite = Annotated[float, Field(allow_inf_nan=False)]
 Positive = Annotated[float, Field(gt=0, allow_inf_nan=False)]
 Vector3 = Annotated[list[Finite], Field(min_length=3, max_length=3)]
 Matrix3 = Annotated[list[Vector3], Field(min_length=3, max_length=3)]
-
-#: Physical quantity of a metric: selects the units an expectation may use.
-Quantity = Literal[
-    "length",
-    "angle",
-    "time",
-    "angular_speed",
-    "area",
-    "volume",
-    "count",
-    "ratio",
-    "bool",
-    "flags",
-]
 
 
 def located_error(loc: tuple[int | str, ...], message: str, value: Any = None) -> Exception:
@@ -73,20 +85,6 @@ def check_target_form(entry: Any) -> None:
             raise ValueError("pose rows must have 4 values")
         if len(entry.pose) == 4 and entry.pose[3] != [0, 0, 0, 1]:
             raise ValueError("the 4th pose row must be [0, 0, 0, 1]")
-
-
-class StrictModel(BaseModel):
-    """Base of every scenario schema: unknown keys are errors, values are frozen, and NaN or
-    infinity is refused in every float field (issue 12: a NaN tolerance disables a check)."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True, allow_inf_nan=False)
-
-
-class Units(StrictModel):
-    """Units in which a scenario states lengths and angles (converted to SI on load)."""
-
-    length: Literal["m", "mm", "in"] = Field("m", description="Length unit of the file.")
-    angle: Literal["rad", "deg"] = Field("rad", description="Angle unit of the file.")
 
 
 class RobotRef(StrictModel):
@@ -148,8 +146,6 @@ class ScenarioModel(StrictModel):
 
     @model_validator(mode="after")
     def _expectations_parse(self) -> ScenarioModel:
-        from lynxplan.scenarios.expect import parse_expectations
-
         parse_expectations(self.expect, type(self).metrics, self.units)
         return self
 
@@ -207,25 +203,6 @@ class KindOutput:
 
 
 @dataclass(frozen=True)
-class ExpectationResult:
-    """One ``expect:`` entry checked against a metric.
-
-    Attributes:
-        name: The key as written in ``expect:``.
-        wanted: The expectation as written (e.g. ``">= 0.2 in"``).
-        got: The measured value, in SI units (None for a value that is not a number).
-        passed: Whether it held.
-        message: A line saying what was measured against what was wanted.
-    """
-
-    name: str
-    wanted: Any
-    got: Any
-    passed: bool
-    message: str
-
-
-@dataclass(frozen=True)
 class Result:
     """The result of one scenario run: what ``report.json`` holds.
 
@@ -274,7 +251,7 @@ class Result:
                 the metric's quantity (naming the valid ones).
         """
         from lynxplan.exceptions import InputError
-        from lynxplan.scenarios.expect import QUANTITY_UNITS, default_unit
+        from lynxplan.scenarios.quantities import QUANTITY_UNITS, default_unit
 
         if name not in self.metrics:
             raise InputError(
@@ -310,7 +287,7 @@ class Result:
         Raises:
             InputError: an unknown metric or unit (see :meth:`unit_of`).
         """
-        from lynxplan.scenarios.expect import QUANTITY_UNITS
+        from lynxplan.scenarios.quantities import QUANTITY_UNITS
 
         unit = self.unit_of(name, units)
         factor = QUANTITY_UNITS.get(self.metric_quantities.get(name, ""), {}).get(unit, 1.0)

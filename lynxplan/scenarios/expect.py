@@ -28,8 +28,7 @@ from typing import Any
 
 import numpy as np
 
-from lynxplan.scenarios.base import ExpectationResult, Quantity, Units
-from lynxplan.units import ANGLE_UNITS, LENGTH_UNITS
+from lynxplan.scenarios.quantities import QUANTITY_UNITS, Quantity, Units, default_unit
 
 #: Comparator text -> function (measured, expected) -> bool.
 COMPARATORS: dict[str, Callable[[float, float], bool]] = {
@@ -40,25 +39,30 @@ COMPARATORS: dict[str, Callable[[float, float], bool]] = {
     "==": lambda measured, expected: math.isclose(measured, expected, rel_tol=1e-9, abs_tol=1e-12),
 }
 
-_LENGTHS = {**LENGTH_UNITS, "cm": 1e-2}
-
-#: Quantity -> unit name -> SI factor.
-QUANTITY_UNITS: dict[str, dict[str, float]] = {
-    "length": _LENGTHS,
-    "angle": dict(ANGLE_UNITS),
-    "time": {"s": 1.0, "ms": 1e-3},
-    "angular_speed": {f"{name}/s": factor for name, factor in ANGLE_UNITS.items()},
-    "area": {f"{name}^2": factor**2 for name, factor in _LENGTHS.items()},
-    "volume": {f"{name}^3": factor**3 for name, factor in _LENGTHS.items()},
-    "count": {"": 1.0},
-    "ratio": {"": 1.0, "%": 0.01},
-}
-
 _NUMBER = r"[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?"
 _PATTERN = re.compile(
     rf"^\s*(?P<op>>=|<=|==|>|<)?\s*(?P<number>{_NUMBER})\s*(?P<unit>[A-Za-z/^%23]*)\s*"
     rf"(\+-|±)?\s*(?P<tol>{_NUMBER})?\s*(?P<tolunit>[A-Za-z/^%23]*)\s*$"
 )
+
+
+@dataclass(frozen=True)
+class ExpectationResult:
+    """One ``expect:`` entry checked against a metric.
+
+    Attributes:
+        name: The key as written in ``expect:``.
+        wanted: The expectation as written (e.g. ``">= 0.2 in"``).
+        got: The measured value, in SI units (None for a value that is not a number).
+        passed: Whether it held.
+        message: A line saying what was measured against what was wanted.
+    """
+
+    name: str
+    wanted: Any
+    got: Any
+    passed: bool
+    message: str
 
 
 @dataclass(frozen=True)
@@ -89,18 +93,6 @@ class ParsedExpectation:
 def _short(value: Any, width: int = 60) -> str:
     text = repr(value)
     return text if len(text) <= width else text[: width - 3] + "..."
-
-
-def default_unit(quantity: str, units: Units) -> str:
-    """Unit of a number written without one, from the file's ``units:`` block."""
-    return {
-        "length": units.length,
-        "angle": units.angle,
-        "time": "s",
-        "angular_speed": f"{units.angle}/s",
-        "area": f"{units.length}^2",
-        "volume": f"{units.length}^3",
-    }.get(quantity, "")
 
 
 def _factor(unit: str, quantity: str, units: Units, text: Any) -> float:
