@@ -47,8 +47,6 @@ from lynxplan.guards.limits import (
     check_size,
     current_limits,
     grid_cells,
-    planning_time,
-    raised_limits,
 )
 from lynxplan.guards.scalars import (
     MAX_ABS_ANGLE,
@@ -62,8 +60,10 @@ from lynxplan.guards.scalars import (
     duration,
     in_range,
     length,
+    planning_time,
     positive,
     positive_length,
+    raised_limits,
     real,
     sample_rate,
     seed,

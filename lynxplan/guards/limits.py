@@ -1,5 +1,6 @@
 """Resource limits checked before any allocation: the most elements one computation may create
-and the longest planning time, raised for a ``with`` block by :func:`raised_limits`."""
+and the longest planning time, raised for a ``with`` block by
+:func:`lynxplan.guards.scalars.raised_limits` (which checks its values with the scalar checks)."""
 
 from __future__ import annotations
 
@@ -7,8 +8,7 @@ import math
 from collections.abc import Iterator
 from contextlib import contextmanager
 from contextvars import ContextVar
-from dataclasses import dataclass, replace
-from typing import Any
+from dataclasses import dataclass
 
 from lynxplan.exceptions import ResourceLimitError
 
@@ -36,29 +36,21 @@ class ResourceLimits:
 
 
 _DEFAULT_LIMITS = ResourceLimits()
+#: The limits set by :func:`lynxplan.guards.scalars.raised_limits` (None: the defaults).
 _LIMITS: ContextVar[ResourceLimits | None] = ContextVar("lynxplan_resource_limits", default=None)
 
 
 def current_limits() -> ResourceLimits:
-    """The resource limits in force (default, or those set by :func:`raised_limits`)."""
+    """The resource limits in force (default, or those set by ``raised_limits``)."""
     return _LIMITS.get() or _DEFAULT_LIMITS
 
 
 @contextmanager
-def raised_limits(
-    max_samples: int | None = None, max_planning_time: float | None = None
-) -> Iterator[ResourceLimits]:
-    """Change the resource limits inside a ``with`` block (values are checked first)."""
-    from lynxplan.guards.scalars import count, positive  # they check sizes against these limits
-
-    changes: dict[str, Any] = {}
-    if max_samples is not None:
-        changes["max_samples"] = count("max_samples", max_samples, minimum=1, limit=None)
-    if max_planning_time is not None:
-        changes["max_planning_time"] = positive("max_planning_time", max_planning_time, "s")
-    token = _LIMITS.set(replace(current_limits(), **changes))
+def limits_in_force(limits: ResourceLimits) -> Iterator[ResourceLimits]:
+    """``limits`` in force inside a ``with`` block (unchecked: ``raised_limits`` checks them)."""
+    token = _LIMITS.set(limits)
     try:
-        yield current_limits()
+        yield limits
     finally:
         _LIMITS.reset(token)
 
@@ -83,22 +75,6 @@ def grid_cells(quantity: str, extent: float, cell: float, dims: int) -> int:
     total = per_axis**dims if per_axis < 1e100 else math.inf
     check_size(f"{quantity} ({per_axis:.3g} per axis for a {cell:.3g} cell)", total, 1.0)
     return math.ceil(per_axis)
-
-
-def planning_time(name: str, value: Any) -> float:
-    """A planning time limit: ``0 < t <= max_planning_time``, in [s]."""
-    from lynxplan.guards.scalars import positive
-
-    x = positive(name, value, "s")
-    limit = current_limits().max_planning_time
-    if x > limit:
-        raise ResourceLimitError(
-            f"{name} (planning time in s)",
-            x,
-            limit,
-            "raise it with raised_limits(max_planning_time=S) in Python",
-        )
-    return x
 
 
 def _as_float(n: float) -> float:

@@ -5,12 +5,15 @@ from __future__ import annotations
 
 import math
 import numbers
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
 
-from lynxplan.exceptions import InputError, NonFiniteInputError, OutOfRangeError
-from lynxplan.guards.limits import check_size
+from lynxplan.exceptions import InputError, NonFiniteInputError, OutOfRangeError, ResourceLimitError
+from lynxplan.guards.limits import ResourceLimits, check_size, current_limits, limits_in_force
 
 #: Largest accepted |angle|, in [rad]. Larger values are errors, not wrapped: nobody means 1e19 rad.
 MAX_ABS_ANGLE = 100.0
@@ -128,3 +131,34 @@ def seed(name: str, value: Any) -> int:
     if n >= MAX_SEED:
         raise OutOfRangeError(name, n, f"an integer with 0 <= {name} < 2**63")
     return n
+
+
+# The limits' own inputs are scalars, checked here (guards.limits, below, holds the limits).
+
+
+@contextmanager
+def raised_limits(
+    max_samples: int | None = None, max_planning_time: float | None = None
+) -> Iterator[ResourceLimits]:
+    """Change the resource limits inside a ``with`` block (values are checked first)."""
+    changes: dict[str, Any] = {}
+    if max_samples is not None:
+        changes["max_samples"] = count("max_samples", max_samples, minimum=1, limit=None)
+    if max_planning_time is not None:
+        changes["max_planning_time"] = positive("max_planning_time", max_planning_time, "s")
+    with limits_in_force(replace(current_limits(), **changes)) as limits:
+        yield limits
+
+
+def planning_time(name: str, value: Any) -> float:
+    """A planning time limit: ``0 < t <= max_planning_time``, in [s]."""
+    x = positive(name, value, "s")
+    limit = current_limits().max_planning_time
+    if x > limit:
+        raise ResourceLimitError(
+            f"{name} (planning time in s)",
+            x,
+            limit,
+            "raise it with raised_limits(max_planning_time=S) in Python",
+        )
+    return x
