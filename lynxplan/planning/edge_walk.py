@@ -37,6 +37,15 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.planning.bounds import (
+    PROBES,
+    STALL_DISTANCE,
+    first_below,
+    joint_poses_upto,
+    pair_bound,
+    primitive_pose,
+    primitive_poses,
+)
 from lynxplan.planning.kernel_model import LANES, njit_no_refcount
 from lynxplan.planning.lanes import (
     MAX_JOINTS,
@@ -45,15 +54,6 @@ from lynxplan.planning.lanes import (
     OUT_S,
     all_pair_bounds,
     pair_along,
-)
-from lynxplan.planning.validity import (
-    PROBES,
-    STALL_DISTANCE,
-    first_below,
-    joint_poses_upto,
-    pair_bound,
-    primitive_pose,
-    primitive_poses,
 )
 
 

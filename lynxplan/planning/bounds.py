@@ -1,0 +1,296 @@
+"""The compiled kernels of the planner's validity checker: the robot's joint and primitive poses,
+each pair's lower bound of the distance, a state's bounds and the clearance probes of an edge.
+
+What the bounds are and how the checker uses them: :mod:`lynxplan.planning.validity` (the
+checker, over these kernels) and :mod:`lynxplan.planning.edge_walk` (edges).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numba
+import numpy as np
+
+from lynxplan.planning.kernel_model import OBSTACLE_SPHERE, njit_no_refcount
+from lynxplan.planning.lanes import all_pair_bounds
+
+#: An edge walk stops when a pair's bound is within this of the required clearance, in [m]:
+#: every step then advances by at least this over the pair's motion rate (no endless creeping).
+STALL_DISTANCE = 2e-4
+#: Pairs whose bounding-sphere gap exceeds the clearance by more than this skip the separating
+#: axis test (its bound cannot limit a step much), in [m].
+SAT_SKIP_DISTANCE = 0.15
+#: The separating-axis bound tries the 9 edge-edge axes only below this face-axis gap, in [m].
+EDGE_AXES_BELOW = 0.02
+
+
+# -- compiled kernels ---------------------------------------------------------------------------
+
+
+@numba.njit(cache=True, inline="always")
+def _compose_into(a: np.ndarray, i: int, b: np.ndarray, j: int, out: np.ndarray, k: int) -> None:
+    """out[k] = a[i] @ b[j] for 4x4 rigid transforms (bottom row 0 0 0 1); a, b, out: (n, 4, 4)
+    stacks, indexed here rather than sliced (a slice of an array costs two atomic reference
+    counts in compiled code: the hot loops take none)."""
+    for r in range(3):
+        a0, a1, a2 = a[i, r, 0], a[i, r, 1], a[i, r, 2]
+        for c in range(4):
+            out[k, r, c] = a0 * b[j, 0, c] + a1 * b[j, 1, c] + a2 * b[j, 2, c]
+        out[k, r, 3] += a[i, r, 3]
+    out[k, 3, 0] = 0.0
+    out[k, 3, 1] = 0.0
+    out[k, 3, 2] = 0.0
+    out[k, 3, 3] = 1.0
+
+
+@numba.njit(cache=True, inline="always")
+def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
+    """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4)."""
+    joint_poses_upto(q, model, scratch, model[3].shape[0] - 1)
+
+
+@numba.njit(cache=True, inline="always")
+def joint_poses_upto(q: np.ndarray, model: Any, scratch: Any, last: int) -> None:
+    """World poses of joint frames 0..last at one configuration q (nq,) -> scratch[0] (a
+    parent's index is below its child's, so those need no other joint).
+
+    The joint rotation is applied to the placement's columns directly (a rotation about one
+    axis mixes two columns), then composed with the parent's pose.
+    """
+    axes, index_q, parents, placement = model[:4]
+    world, local = scratch[0], scratch[1]
+    for i in range(4):
+        for j in range(4):
+            world[0, i, j] = 1.0 if i == j else 0.0
+    for j in range(1, last + 1):
+        angle = q[index_q[j]]
+        c, s = math.cos(angle), math.sin(angle)
+        a = axes[j]
+        i1, i2 = (a + 1) % 3, (a + 2) % 3
+        for r in range(3):
+            first, second = placement[j, r, i1], placement[j, r, i2]
+            local[0, r, i1] = c * first + s * second
+            local[0, r, i2] = c * second - s * first
+            local[0, r, a] = placement[j, r, a]
+            local[0, r, 3] = placement[j, r, 3]
+        _compose_into(world, parents[j], local, 0, world, j)
+
+
+@numba.njit(cache=True, inline="always")
+def primitive_pose(g: int, model: Any, scratch: Any) -> None:
+    """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
+    _compose_into(scratch[0], model[4][g], model[5], g, scratch[3], g)
+
+
+@njit_no_refcount()
+def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
+    """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
+    joint_poses(q, model, scratch)
+    for g in range(model[4].shape[0]):
+        primitive_pose(g, model, scratch)
+
+
+@njit_no_refcount()
+def _separating_axis_gap(
+    pa: np.ndarray,
+    ia: int,
+    ha: np.ndarray,
+    pb: np.ndarray,
+    ib: int,
+    hb: np.ndarray,
+    jb: int,
+    r: np.ndarray,
+) -> float:
+    """Largest projected gap of two oriented boxes over the SAT axes (a distance lower bound).
+
+    Box a: pose pa[ia] (4, 4) (rotation columns = box axes), half sizes ha[ia] (3,); box b: pose
+    pb[ib], half sizes hb[jb]; r: scratch (3, 3). The stacks are indexed here, not sliced (no
+    reference counting in the hot loops). The 9 edge-edge axes are only tried when the 6 face
+    axes leave a gap below :data:`EDGE_AXES_BELOW` (any subset of axes gives a valid bound).
+    """
+    t0 = pb[ib, 0, 3] - pa[ia, 0, 3]
+    t1 = pb[ib, 1, 3] - pa[ia, 1, 3]
+    t2 = pb[ib, 2, 3] - pa[ia, 2, 3]
+    for i in range(3):
+        for j in range(3):
+            r[i, j] = abs(
+                pa[ia, 0, i] * pb[ib, 0, j]
+                + pa[ia, 1, i] * pb[ib, 1, j]
+                + pa[ia, 2, i] * pb[ib, 2, j]
+            )
+    a0, a1, a2 = ha[ia, 0], ha[ia, 1], ha[ia, 2]
+    b0, b1, b2 = hb[jb, 0], hb[jb, 1], hb[jb, 2]
+    best = -np.inf
+    for i in range(3):  # axes of box a
+        proj = abs(pa[ia, 0, i] * t0 + pa[ia, 1, i] * t1 + pa[ia, 2, i] * t2)
+        gap = proj - ha[ia, i] - b0 * r[i, 0] - b1 * r[i, 1] - b2 * r[i, 2]
+        best = max(best, gap)
+    for j in range(3):  # axes of box b
+        proj = abs(pb[ib, 0, j] * t0 + pb[ib, 1, j] * t1 + pb[ib, 2, j] * t2)
+        gap = proj - hb[jb, j] - a0 * r[0, j] - a1 * r[1, j] - a2 * r[2, j]
+        best = max(best, gap)
+    if best >= EDGE_AXES_BELOW:
+        return best
+    for i in range(3):  # cross products a_i x b_j, normalised
+        ax0, ax1, ax2 = pa[ia, 0, i], pa[ia, 1, i], pa[ia, 2, i]
+        for j in range(3):
+            bx0, bx1, bx2 = pb[ib, 0, j], pb[ib, 1, j], pb[ib, 2, j]
+            l0 = ax1 * bx2 - ax2 * bx1
+            l1 = ax2 * bx0 - ax0 * bx2
+            l2 = ax0 * bx1 - ax1 * bx0
+            norm = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
+            if norm < 1e-9:
+                continue
+            gap = abs(l0 * t0 + l1 * t1 + l2 * t2)
+            for k in range(3):
+                gap -= ha[ia, k] * abs(l0 * pa[ia, 0, k] + l1 * pa[ia, 1, k] + l2 * pa[ia, 2, k])
+                gap -= hb[jb, k] * abs(l0 * pb[ib, 0, k] + l1 * pb[ib, 1, k] + l2 * pb[ib, 2, k])
+            gap /= norm
+            best = max(best, gap)
+    return best
+
+
+@numba.njit(cache=True, inline="always")
+def _point_box_distance(
+    p: np.ndarray, ip: int, poses: np.ndarray, g: int, half: np.ndarray
+) -> float:
+    """Distance from point p[ip] (3,) to the solid box of pose poses[g] (4, 4) and half sizes
+    half[g] (3,) (0 inside)."""
+    total = 0.0
+    dx = p[ip, 0] - poses[g, 0, 3]
+    dy = p[ip, 1] - poses[g, 1, 3]
+    dz = p[ip, 2] - poses[g, 2, 3]
+    for k in range(3):
+        excess = abs(poses[g, 0, k] * dx + poses[g, 1, k] * dy + poses[g, 2, k] * dz) - half[g, k]
+        if excess > 0.0:
+            total += excess * excess
+    return math.sqrt(total)
+
+
+@numba.njit(cache=True, inline="always")
+def centre_gap(pa: np.ndarray, a: int, ra: float, pb: np.ndarray, b: int, rb: float) -> float:
+    """Gap of two bounding spheres: centres at the translations of poses pa[a], pb[b] (4, 4),
+    radii ra, rb, in [m] (a lower bound of the distance of anything inside them)."""
+    dx, dy, dz = pb[b, 0, 3] - pa[a, 0, 3], pb[b, 1, 3] - pa[a, 1, 3], pb[b, 2, 3] - pa[a, 2, 3]
+    gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - ra - rb
+    return gap
+
+
+@numba.njit(cache=True, inline="always")
+def pair_bound(p: int, model: Any, scratch: Any) -> float:
+    """Lower bound of pair p's distance at the poses in scratch[3], in [m]."""
+    return pair_bound_below(p, model, scratch, SAT_SKIP_DISTANCE)
+
+
+@numba.njit(cache=True, inline="always")
+def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
+    """:func:`pair_bound` where only whether it reaches ``enough`` [m] matters above that: the
+    bounding-sphere gap when it is at least ``min(enough, SAT_SKIP_DISTANCE)`` (no separating
+    axis test), else the tight bound. Either is a lower bound of the distance."""
+    prim_half, prim_radius, pairs = model[6], model[7], model[8]
+    kinds, centres, poses_b, obstacle_half, obstacle_radius = model[10:15]
+    poses = scratch[3]
+    a, b = pairs[p, 0], pairs[p, 1]
+    skip = min(enough, SAT_SKIP_DISTANCE)
+    if pairs[p, 2] == 1:
+        gap = centre_gap(poses, a, prim_radius[a], poses, b, prim_radius[b])
+        if gap < skip:
+            sat = _separating_axis_gap(poses, a, prim_half, poses, b, prim_half, b, scratch[8])
+            gap = max(gap, sat)
+        return float(gap)
+    if kinds[b] == OBSTACLE_SPHERE:
+        return float(_point_box_distance(centres, b, poses, a, prim_half) - obstacle_half[b, 0])
+    dx = centres[b, 0] - poses[a, 0, 3]
+    dy = centres[b, 1] - poses[a, 1, 3]
+    dz = centres[b, 2] - poses[a, 2, 3]
+    gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - obstacle_radius[b]
+    if gap < skip:
+        sat = _separating_axis_gap(poses, a, prim_half, poses_b, b, obstacle_half, b, scratch[8])
+        gap = max(gap, sat)
+    return float(gap)
+
+
+@njit_no_refcount()
+def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> None:
+    """Lower bound of the distance of every pair at q (nq,) -> out (P,), in [m] (all pairs at
+    once: :func:`lynxplan.planning.lanes.all_pair_bounds`)."""
+    primitive_poses(q, model, scratch)
+    all_pair_bounds(model, scratch[3], out)
+
+
+@njit_no_refcount()
+def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
+    """Smallest pair bound at q (nq,), in [m] (inf without pairs)."""
+    bounds = scratch[18][0]
+    state_bounds(q, model, scratch, bounds)
+    best = np.inf
+    for p in range(bounds.shape[0]):
+        best = min(best, bounds[p])
+    return best
+
+
+@njit_no_refcount()
+def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: np.ndarray) -> int:
+    """Every pair's bound at q (nq,) -> out (P,), in [m], and the first pair whose bound is at
+    most ``threshold`` [m] (-1: none). The pair that failed last (scratch[9][3]) is tried
+    alone first (a blocked region usually blocks the same pair): when it fails, -2 - that pair
+    is returned and out is not filled."""
+    primitive_poses(q, model, scratch)
+    count, last = model[8].shape[0], scratch[9][3]
+    if last < count and pair_bound_below(last, model, scratch, threshold) <= threshold:
+        return int(-2 - last)
+    all_pair_bounds(model, scratch[3], out)
+    for p in range(count):
+        if out[p] <= threshold:
+            scratch[9][3] = p
+            return p
+    return -1
+
+
+@njit_no_refcount()
+def point_is_clear(
+    q_a: np.ndarray,
+    q_b: np.ndarray,
+    s: float,
+    model: Any,
+    scratch: Any,
+    clearance: float,
+    row: int,
+) -> bool:
+    """Whether every pair's bound exceeds clearance + STALL_DISTANCE at q_a + s (q_b - q_a).
+
+    A quick rejection before an edge walk (a blocked edge usually has a blocked point there):
+    it stops at the first failing pair, trying first the pair that failed last (scratch[9][3]).
+    When it passes, the edge walk may use its bounds: they are in grid row ``row``
+    (scratch[18][row], (P,), in [m]; the point's parameter s in scratch[20][row]).
+    """
+    q = scratch[7]
+    for j in range(q_a.shape[0]):
+        q[j] = q_a[j] + s * (q_b[j] - q_a[j])
+    scratch[20][row] = s
+    return first_below(q, model, scratch, clearance + STALL_DISTANCE, scratch[18][row]) == -1
+
+
+@numba.njit(cache=True, inline="always")
+def probes_are_clear(
+    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
+) -> bool:
+    """:func:`point_is_clear` at s = 1/4, 3/4, then 1/2 of the edge (their bounds are then grid
+    rows 0, 2 and 1: the walk's grid of :data:`PROBES` points, for
+    :func:`lynxplan.planning.edge_walk.edge_is_free_after_probes`).
+
+    Before an edge walk whose only use is a whole certified edge (a shortcut, the straight
+    edge to a goal): a blocked edge is usually blocked at one of these points, and a test
+    there costs one configuration's bounds, where the walk would advance to the obstacle
+    first. A pair far enough from everything is then certified by the grid alone."""
+    return (
+        point_is_clear(q_a, q_b, 0.25, model, scratch, clearance, np.int64(0))
+        and point_is_clear(q_a, q_b, 0.75, model, scratch, clearance, np.int64(2))
+        and point_is_clear(q_a, q_b, 0.5, model, scratch, clearance, np.int64(1))
+    )
+
+
+#: Grid points that :func:`probes_are_clear` leaves for the edge walk.
+PROBES = 3
