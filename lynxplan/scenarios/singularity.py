@@ -25,8 +25,7 @@ from lynxplan.scenarios.base import (
     Units,
     scaled,
 )
-from lynxplan.singularity.measures import (
-    make_task,
+from lynxplan.singularity.classify import (
     max_manipulability,
     singular_conditions,
     singularity_distances,
@@ -42,6 +41,7 @@ from lynxplan.singularity.resolved_rate import (
     run_all,
     run_metrics,
 )
+from lynxplan.singularity.tasks import make_task
 from lynxplan.units import angle_factor, length_factor
 
 NAME = "singularity"

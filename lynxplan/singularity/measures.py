@@ -10,7 +10,7 @@ A *task* is a selection of rows of the extended tool Jacobian ``E(q)``, shape (8
 Manipulability ``m(q) = sqrt(det(J J^T))`` of the task Jacobian ``J = E[rows]`` (units: product of
 the rows' units), its gradient ``dm/dq = m tr(J^+ dJ/dq_j)`` from the closed-form derivative of
 ``E`` (checked in the tests against finite differences and Pinocchio's Jacobian time variation),
-the condition number, and the arm's singular configurations.
+the condition number. The arm's singular configurations: :mod:`lynxplan.singularity.classify`.
 
 Singular configurations (derived from the closed form, ``r`` = radial distance of the tool point
 from the base axis, ``r_w`` that of the wrist centre):
@@ -23,14 +23,14 @@ from the base axis, ``r_w`` that of the wrist centre):
 - ``position_pitch`` (4 rows) and ``position_pitch_roll`` (5 rows, the square task): with the
   pitch fixed the tool point moves like the wrist centre of the 2-link arm, so
   ``m = |r| a2 a3 |sin q3|``: tool point on the base axis, elbow stretched or folded.
-- Other row selections: :func:`singular_conditions` finds which of the conditions make ``m``
-  vanish by evaluating it on configurations that satisfy each condition.
+- Other row selections: :func:`lynxplan.singularity.classify.singular_conditions` finds which
+  of the conditions make ``m`` vanish by evaluating it on configurations that satisfy each
+  condition.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -151,33 +151,9 @@ def condition_number(
     return float(ratio) if np.ndim(q) == 1 else ratio
 
 
-if TYPE_CHECKING:  # the names below, for type checkers (explicit re-exports)
-    from lynxplan.singularity.classify import (
-        Singularity,
-        SingularityDistance,
-        max_manipulability,
-        near_singularities,
-        nearest_singularity,
-        singular_conditions,
-        singularity_distances,
-    )
-
-
-def __getattr__(name: str) -> object:
-    """The names of :mod:`lynxplan.singularity.classify` listed in ``__all__``, loaded on first
-    use (classify builds on this module)."""
-    if name in __all__:
-        from lynxplan.singularity import classify
-
-        return getattr(classify, name)
-    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-
-
 __all__ = [
     "NAMED_TASKS",
     "ROW_NAMES",
-    "Singularity",
-    "SingularityDistance",
     "Task",
     "condition_number",
     "extended_jacobian",
@@ -189,13 +165,8 @@ __all__ = [
     "manipulability_and_gradient",
     "manipulability_gradient",
     "manipulability_kernel",
-    "max_manipulability",
     "measures_kernel",
-    "near_singularities",
-    "nearest_singularity",
-    "singular_conditions",
     "singular_values",
-    "singularity_distances",
     "task_jacobian",
     "task_jacobian_derivative",
 ]

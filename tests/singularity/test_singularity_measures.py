@@ -28,7 +28,7 @@ from lynxplan.singularity import (
     task_jacobian,
     task_jacobian_derivative,
 )
-from lynxplan.singularity.measures import max_manipulability
+from lynxplan.singularity.classify import max_manipulability
 
 #: Closed form vs Pinocchio (both exact): floating-point noise only.
 EXACT_ATOL = 1e-12
