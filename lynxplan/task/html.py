@@ -8,8 +8,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from lynxplan.scenarios.task import Scenario
     from lynxplan.task.run import TaskResult
+    from lynxplan.task.schema import Scenario
 
 #: The pen path drawn in the HTML is sub-sampled to this rate, in [Hz] (smaller file).
 PATH_RATE = 100.0

@@ -16,8 +16,8 @@ from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
     from lynxplan.scenarios.expect import ParsedExpectation
-    from lynxplan.scenarios.task import Scenario
     from lynxplan.task.run import TaskResult
+    from lynxplan.task.schema import Scenario
 
 MOTION_COLOURS = {"line": "tab:red", "free": "tab:blue"}
 OBSTACLE_COLOUR = "tab:orange"

@@ -15,8 +15,8 @@ from lynxplan.constants import COAL_GJK_TOLERANCE, FCL_DISTANCE_TOLERANCE
 from lynxplan.units import angle_factor, length_factor
 
 if TYPE_CHECKING:
-    from lynxplan.scenarios.task import Scenario
     from lynxplan.task.run import TaskResult
+    from lynxplan.task.schema import Scenario
 
 ACCURACY_STATEMENT = (
     "Clearances are exact distances between the URDF collision primitives (boxes, cylinders) and "

@@ -17,7 +17,7 @@ from lynxplan.constants import LIMIT_CHECK_RELATIVE_TOLERANCE, LIMIT_SNAP_TOLERA
 from lynxplan.task.setup import TaskSetup, resolve
 
 if TYPE_CHECKING:
-    from lynxplan.scenarios.task import Scenario
+    from lynxplan.task.schema import Scenario
 
 __all__ = ["LimitCheck", "TaskResult", "execute", "html_name"]
 

@@ -15,6 +15,7 @@ import numpy as np
 from lynxplan.constants import LIMIT_SNAP_TOLERANCE
 from lynxplan.exceptions import LynxplanError, ScenarioValueError
 from lynxplan.scenarios.robot import load_path_robot
+from lynxplan.task.schema import route
 from lynxplan.units import angle_factor, length_factor
 from lynxplan.viz import WritingPlane
 
@@ -22,7 +23,7 @@ if TYPE_CHECKING:
     from lynxplan.arm.model import Arm
     from lynxplan.collision.obstacles import Obstacle
     from lynxplan.robots import Robot
-    from lynxplan.scenarios.task import (
+    from lynxplan.task.schema import (
         BoxEntry,
         CylinderEntry,
         Scenario,
@@ -272,33 +273,6 @@ def _check_within_limits(
                 f"[{lower[j] / angle:.6g}, {upper[j] / angle:.6g}] (file's angle unit)",
                 q[j] / angle,
             )
-
-
-def route(scenario: Scenario) -> tuple[tuple[str, str], ...]:
-    names = list(scenario.waypoints)
-    valid = ", ".join(names)
-    route: list[tuple[str, str]] = []
-    previous: str | None = None
-    for i, entry in enumerate(scenario.segments):
-        for key, value in (("from", entry.from_), ("to", entry.to)):
-            if value is not None and value not in scenario.waypoints:
-                raise _InvalidError(
-                    ("segments", i, key), f"unknown waypoint {value!r}; waypoints: {valid}", value
-                )
-        start = entry.from_ if entry.from_ is not None else previous
-        if start is None:
-            raise _InvalidError(
-                ("segments", 0, "from"), "the first segment needs a 'from' waypoint"
-            )
-        if previous is not None and start != previous:
-            raise _InvalidError(
-                ("segments", i, "from"),
-                f"{start!r} but segment {i - 1} ends at {previous!r} (segments are chained)",
-                start,
-            )
-        route.append((start, entry.to))
-        previous = entry.to
-    return tuple(route)
 
 
 def _planned_vias(
