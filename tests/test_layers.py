@@ -1,4 +1,5 @@
-"""The dependency arrows point one way: cli -> scenarios -> domain -> core.
+"""The dependency arrows point one way: cli -> scenarios -> domain -> core, and no import cycle
+anywhere in the package (the IK solvers never import the Robot).
 
 Domain packages take and return arrays and typed values: they never import pydantic, YAML, the
 scenario layer or the command line (checked on the source, imports inside functions included).
@@ -54,3 +55,118 @@ def test_the_scenario_layer_does_not_import_the_command_line():
         if name.startswith(("lynxplan.cli", "lynxplan.commands"))
     }
     assert not offenders, sorted(offenders)
+
+
+# -- import cycles ----------------------------------------------------------------------------
+# A module imports another when any import statement names it (module level, inside a function,
+# or under TYPE_CHECKING alike: each is an arrow a reader has to follow). The cycles are the
+# strongly connected components of that graph with more than one module (Tarjan).
+
+
+def _modules(root: Path) -> dict[str, Path]:
+    """Dotted module name -> file, for every module of the package at ``root``."""
+    out = {}
+    for path in root.rglob("*.py"):
+        name = ".".join(path.with_suffix("").relative_to(root.parent).parts)
+        out[name.removesuffix(".__init__")] = path
+    return out
+
+
+def _import_graph(modules: dict[str, Path]) -> dict[str, set[str]]:
+    """Module -> the package's modules it imports (a package's ``__init__`` is not an edge)."""
+    graph: dict[str, set[str]] = {name: set() for name in modules}
+    for name, path in modules.items():
+        package = name if path.name == "__init__.py" else name.rsplit(".", 1)[0]
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"), str(path))):
+            if isinstance(node, ast.Import):
+                targets = [alias.name for alias in node.names]
+            elif isinstance(node, ast.ImportFrom):
+                base = node.module or ""
+                if node.level:
+                    parts = package.split(".")[: len(package.split(".")) - node.level + 1]
+                    base = ".".join(parts + ([base] if base else []))
+                targets = [base] + [f"{base}.{alias.name}" for alias in node.names]
+            else:
+                continue
+            for imported in targets:
+                target = imported
+                while target and target not in modules:
+                    target = target.rsplit(".", 1)[0] if "." in target else ""
+                if target and target != name and modules[target].name != "__init__.py":
+                    graph[name].add(target)
+    return graph
+
+
+def import_cycles(graph: dict[str, set[str]]) -> list[list[str]]:
+    """The strongly connected components of more than one module, each sorted (iterative
+    Tarjan: no recursion limit on a deep package)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    stack: list[str] = []
+    on_stack: set[str] = set()
+    found: list[list[str]] = []
+    for root, imported in graph.items():
+        if root in index:
+            continue
+        work = [(root, iter(sorted(imported)))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            v, children = work[-1]
+            w = next(children, None)
+            if w is not None:
+                if w not in index:
+                    index[w] = low[w] = len(index)
+                    stack.append(w)
+                    on_stack.add(w)
+                    work.append((w, iter(sorted(graph[w]))))
+                elif w in on_stack:
+                    low[v] = min(low[v], index[w])
+                continue
+            work.pop()
+            if work:
+                low[work[-1][0]] = min(low[work[-1][0]], low[v])
+            if low[v] == index[v]:
+                component = []
+                while True:
+                    w = stack.pop()
+                    on_stack.discard(w)
+                    component.append(w)
+                    if w == v:
+                        break
+                if len(component) > 1:
+                    found.append(sorted(component))
+    return found
+
+
+def test_the_cycle_finder_finds_a_cycle_and_only_cycles():
+    graph = {"a": {"b"}, "b": {"c"}, "c": {"a"}, "d": {"a"}, "e": {"f"}, "f": set()}
+    assert import_cycles(graph) == [["a", "b", "c"]]
+    assert import_cycles({"a": {"b"}, "b": set()}) == []
+
+
+def test_the_cycle_finder_sees_imports_inside_functions_and_type_checking(tmp_path):
+    package = tmp_path / "pkg"
+    package.mkdir()
+    (package / "__init__.py").write_text("")
+    (package / "low.py").write_text("def f():\n    from pkg.high import g\n")
+    (package / "high.py").write_text(
+        "from typing import TYPE_CHECKING\nif TYPE_CHECKING:\n    from . import low\n"
+    )
+    assert import_cycles(_import_graph(_modules(package))) == [["pkg.high", "pkg.low"]]
+
+
+def test_no_import_cycle_anywhere_in_the_package():
+    cycles = import_cycles(_import_graph(_modules(PACKAGE)))
+    assert not cycles, [" <-> ".join(c) for c in cycles]
+
+
+def test_the_ik_solvers_never_import_the_robot():
+    """The solvers take a plain kinematic description (chain, family, limits), never the Robot
+    (imports under TYPE_CHECKING count too)."""
+    graph = _import_graph(_modules(PACKAGE))
+    solvers = [name for name in graph if name.startswith("lynxplan.robots.ik.")]
+    assert "lynxplan.robots.ik.family_solver" in solvers
+    offenders = [name for name in solvers if "lynxplan.robots.robot" in graph[name]]
+    assert not offenders, offenders

@@ -14,11 +14,8 @@ straight down towards the outward direction of the arm plane; the AL5's q2 + q3 
 
 from __future__ import annotations
 
-import functools
-import importlib
 from functools import cached_property
 from pathlib import Path
-from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -30,9 +27,18 @@ from lynxplan.exceptions import ShapeError, TargetError
 from lynxplan.robots import chain as _chain
 from lynxplan.robots.family import FamilyParameters, recognise_family
 from lynxplan.robots.hull_cache import geometry_model
+from lynxplan.robots.ik import dispatch
+from lynxplan.robots.ik.description import Kinematics
 from lynxplan.robots.loading import BuiltinRobot, LoadedModel
-from lynxplan.robots.results import JointInfo, RobotIkBatch, RobotIkResult, RobotInfo, TrackResult
-from lynxplan.robots.selection import REACH_TOLERANCE, TRACK_JUMP_THRESHOLD, select_one, track
+from lynxplan.robots.results import (
+    JointInfo,
+    RobotIkBatch,
+    RobotIkResult,
+    RobotIkSolution,
+    RobotInfo,
+    TrackResult,
+)
+from lynxplan.robots.selection import REACH_TOLERANCE, select_one
 from lynxplan.robots.targets import (
     KIND_APPROACH,
     KIND_PITCH,
@@ -41,6 +47,7 @@ from lynxplan.robots.targets import (
     as_array,
     make_target,
 )
+from lynxplan.robots.tracking import TRACK_JUMP_THRESHOLD, track
 
 __all__ = [
     "KIND_APPROACH",
@@ -52,12 +59,6 @@ __all__ = [
     "Target",
     "make_target",
 ]
-
-
-@functools.cache
-def _family_solver() -> ModuleType:
-    """The family solver module, imported on first use (it loads the numba kernels)."""
-    return importlib.import_module("lynxplan.robots.ik.family_solver")
 
 
 class Robot:
@@ -75,6 +76,7 @@ class Robot:
         family_reason: The family name, or why the chain is not in it.
         disabled_collisions: Link pairs not checked for self-collision (from the SRDF).
         nq: Number of joints.
+        kinematics: What the IK solvers know of the arm (chain, family, limits): plain data.
     """
 
     def __init__(self, loaded: LoadedModel, builtin: BuiltinRobot | None = None) -> None:
@@ -112,21 +114,15 @@ class Robot:
             from lynxplan.arm.model import load_arm
 
             self._arm = load_arm()
+        self.kinematics = Kinematics(
+            self.chain, family, self.limits.lower, self.limits.upper, self._arm
+        )
 
     # -- description ------------------------------------------------------------------------
-    @cached_property
+    @property
     def ik_solver(self) -> str:
         """Name of the IK solver this robot uses."""
-        if self.family is None:
-            return "numerical (Levenberg-Marquardt, multi-start)"
-        name = "yaw-pitch3-roll closed form"
-        if not self.family.tool_on_roll_axis:
-            name += " + roll root search (off-axis tool; reachable poses: roll from orientation)"
-        if not self.family.exact:
-            name += f" + Newton polish (model off the family by {self.family.deviation:.2g} rad)"
-        if self._arm is not None:
-            name += "; poses and approach targets by lynxplan.arm (AL5 kernels)"
-        return name
+        return self.kinematics.solver_name
 
     def info(self) -> RobotInfo:
         """Joints, limits, family and its parameters, IK solver."""
@@ -270,16 +266,8 @@ class Robot:
             roll equation x elbow).
         """
         target = make_target(poses, positions, approaches, pitches, rolls)
-        return self._solve(target, self._reference(q_reference, target.poses.shape[0]))
-
-    def _solve(self, target: Target, reference: np.ndarray) -> RobotIkBatch:
-        if self.family is None:
-            from lynxplan.robots.ik.numerical_solver import solve_numerical
-
-            return solve_numerical(self, target, reference)
-        from lynxplan.robots.ik.family_solver import solve_family
-
-        return solve_family(self, target, reference)
+        reference = self._reference(q_reference, target.poses.shape[0])
+        return dispatch.solve(self.kinematics, target, reference)
 
     def ik(
         self,
@@ -326,11 +314,9 @@ class Robot:
             and self.family is not None
         ):
             # the lean paths; a pose they cannot solve (NaN/inf, out of reach) goes on below
-            one: RobotIkResult | None = _family_solver().solve_pose_one(
-                self, pose, self._reference(q_reference, 1)[0], verify
-            )
+            one = dispatch.solve_pose_one(self.kinematics, pose, self._reference(q_reference, 1)[0])
             if one is not None:
-                return one
+                return self._verified(one) if verify else one
         if approach_only:
             if pose is None:
                 raise TargetError("approach_only needs a pose (position and approach columns)")
@@ -346,8 +332,27 @@ class Robot:
             None if roll is None else [roll],
         )
         reference = self._reference(q_reference, 1)
-        batch = self._solve(target, reference)
-        return select_one(self, batch, reference[0], verify)
+        result = select_one(
+            dispatch.solve(self.kinematics, target, reference), reference[0], self.ik_solver
+        )
+        return self._verified(result) if verify else result
+
+    def _verified(self, result: RobotIkResult) -> RobotIkResult:
+        """``result``, once Pinocchio's FK of each branch agrees with the solver's own FK.
+
+        Raises:
+            IkFailedError: a branch where they disagree by more than 1e-12 m.
+        """
+        from lynxplan.exceptions import IkFailedError
+
+        solutions: tuple[RobotIkSolution, ...] = result.solutions
+        for s in solutions:
+            placement = self.frame_placement(s.q)
+            own = self.fk(s.q)
+            gap = float(np.abs(placement[:3] - own[:3]).max())
+            if gap > 1e-12:
+                raise IkFailedError(s.position_error, f"Pinocchio FK disagrees by {gap:.3g} m")
+        return result
 
     def ik_track(
         self,
@@ -372,7 +377,8 @@ class Robot:
             (index, size) and the unsolved indices; never a silent branch flip.
         """
         target = make_target(poses, positions, approaches, pitches, rolls)
-        return track(self, target, self._reference(q0, 1)[0], q0 is not None, jump_threshold)
+        start = self._reference(q0, 1)[0]
+        return track(self.kinematics, target, start, q0 is not None, jump_threshold)
 
     # -- workspace -----------------------------------------------------------------------------
     def workspace(self, samples: int = 100_000, seed: int = 0) -> np.ndarray:

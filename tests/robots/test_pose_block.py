@@ -274,7 +274,7 @@ def test_full_poses_of_an_off_axis_tool_have_eight_slots() -> None:
     )
     target = make_target(poses)
     full = BranchSlots.empty(len(poses), 24)
-    family_solver._kernel(robot, target, robot._default_reference, full)
+    family_solver._kernel(robot.kinematics, target, robot._default_reference, full)
     packed = family_solver.pack_rolls(full, 2)
     rolls_used = full.valid.reshape(-1, 2, 6, 2).any(axis=3).sum(axis=2).max(axis=1)
     few = rolls_used <= 2

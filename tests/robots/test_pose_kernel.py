@@ -30,8 +30,8 @@ def _general(robot: Robot, poses: np.ndarray) -> list[np.ndarray]:
     if robot.family.tool_on_roll_axis:
         slots = 4
     out = BranchSlots.empty(n, slots)
-    family_solver._kernel(robot, target, robot._default_reference, out)
-    family_solver.rescue_near_axis(robot, target, out)
+    family_solver._kernel(robot.kinematics, target, robot._default_reference, out)
+    family_solver.rescue_near_axis(robot.kinematics, target, out)
     q, valid, _, perr, oerr = out
     exact = valid & (perr <= EXACT) & (oerr <= EXACT)
     return [q[i][exact[i]] for i in range(n)]
@@ -131,7 +131,7 @@ def test_al5_single_pose_path_matches_the_batch() -> None:
     for pose in [*poses, far]:
         one = robot.ik(pose)
         batch = robot.ik_batch(pose[None])
-        other = select_one(robot, batch, robot._default_reference[0], verify=False)
+        other = select_one(batch, robot._default_reference[0], robot.ik_solver)
         assert one.selected == other.selected and one.reachable == other.reachable
         np.testing.assert_allclose(
             [s.q for s in one.solutions], [s.q for s in other.solutions], atol=0

@@ -16,8 +16,8 @@ from lynxplan.robots.ik.family_geometry import MODE_APPROACH
 from lynxplan.robots.ik.family_polish import axis_angle, rotation_angle
 
 if TYPE_CHECKING:
+    from lynxplan.robots.ik.description import Kinematics
     from lynxplan.robots.results import BranchSlots, RobotIkResult
-    from lynxplan.robots.robot import Robot
     from lynxplan.robots.targets import Target
 
 
@@ -48,7 +48,9 @@ def branch_errors(
                 orientation_error[n, b] = rotation_angle(goal, pose)
 
 
-def al5_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> np.ndarray:
+def al5_fill(
+    kinematics: Kinematics, target: Target, reference: np.ndarray, out: BranchSlots
+) -> np.ndarray:
     """Targets the AL5 kernels of lynxplan.arm solve, into the batch arrays (N, 4, ...);
     returns which (the others need the general kernel)."""
     from lynxplan.arm.ik import IkStatus
@@ -56,7 +58,7 @@ def al5_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlo
     ref = np.broadcast_to(reference, (target.poses.shape[0], 5)).copy()
     given = ~np.isnan(target.roll)
     ref[given, 4] = target.roll[given]
-    arm = robot._arm
+    arm = kinematics.arm
     approach_only = target.kind == MODE_APPROACH
     batch = arm.ik_batch(target.poses, q_reference=ref, approach_only=approach_only)
     ok: np.ndarray = np.asarray(np.asarray(batch.status) == IkStatus.OK)
@@ -76,7 +78,7 @@ def al5_fill(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlo
 
 
 def solve_al5_pose_one(
-    robot: Robot, pose: np.ndarray, reference: np.ndarray, verify: bool
+    kinematics: Kinematics, pose: np.ndarray, reference: np.ndarray
 ) -> RobotIkResult | None:
     """One full pose (4, 4) through ``Arm.ik`` (the lean single-pose kernel): the result, or
     None where the pose needs the general path (out of reach, not rigid, not finite).
@@ -89,10 +91,10 @@ def solve_al5_pose_one(
     from lynxplan.robots.selection import finish_result
 
     try:
-        result = robot._arm.ik(pose, q_reference=reference)
+        result = kinematics.arm.ik(pose, q_reference=reference)
     except (UnreachablePoseError, NotRigidTransformError, NonFiniteInputError):
         return None
     solutions = list(result.solutions)  # the AL5's branch type is the Robot's
     distance = min(s.position_error for s in solutions)
     rows = [s.q.tolist() for s in solutions]
-    return finish_result(robot, solutions, rows, True, distance, reference, verify)
+    return finish_result(solutions, rows, True, distance, reference, kinematics.solver_name)

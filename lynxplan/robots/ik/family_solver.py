@@ -1,5 +1,6 @@
 """Python side of the yaw-pitch-pitch-pitch-roll solver: kernel calls, the near-axis rescue,
-the single-pose path, results (the AL5 delegation: ``al5_bridge``)."""
+the single-pose path, results (the AL5 delegation: ``al5_bridge``). Every function takes the
+arm's plain :class:`~lynxplan.robots.ik.description.Kinematics`."""
 
 from __future__ import annotations
 
@@ -18,7 +19,8 @@ from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
 if TYPE_CHECKING:
-    from lynxplan.robots.robot import Robot, Target
+    from lynxplan.robots.ik.description import Kinematics
+    from lynxplan.robots.targets import Target
 
 _jit.listen()  # the IK kernels: a notice when their first compile takes long
 
@@ -42,18 +44,18 @@ def branch_names(slots: int) -> tuple[str, ...]:
     )
 
 
-def slot_count(robot: Robot, target: Target) -> int:
+def slot_count(kinematics: Kinematics, target: Target) -> int:
     """Branch slots of the batch layout: 4 (side x elbow: the roll given, or fixed by the
     orientation of a tool on the roll axis), 4 * POSE_ROLLS (full poses of an off-axis tool)
     or 4 * MAX_ROOTS (approach targets of an off-axis tool: every root of the roll equation)."""
-    if not needs_root_search(robot, target):
+    if not needs_root_search(kinematics, target):
         return 4
     return 4 * (POSE_ROLLS if target.kind == fk_.MODE_POSE else fk_.MAX_ROOTS)
 
 
-def needs_root_search(robot: Robot, target: Target) -> bool:
+def needs_root_search(kinematics: Kinematics, target: Target) -> bool:
     """Whether the roll is found by root search (off-axis tool, roll not given, not pitch)."""
-    family = robot.family
+    family = kinematics.family
     assert family is not None
     return (
         not family.tool_on_roll_axis
@@ -62,39 +64,39 @@ def needs_root_search(robot: Robot, target: Target) -> bool:
     )
 
 
-def solve_family(robot: Robot, target: Target, reference: np.ndarray) -> RobotIkBatch:
+def solve_family(kinematics: Kinematics, target: Target, reference: np.ndarray) -> RobotIkBatch:
     """Every branch of each target (see ``family_kernel``)."""
-    family = robot.family
+    family = kinematics.family
     assert family is not None
     n = target.poses.shape[0]
-    slots = slot_count(robot, target)
+    slots = slot_count(kinematics, target)
     out = BranchSlots.empty(n, slots)
-    if target.kind == fk_.MODE_POSE and robot._arm is None:
+    if target.kind == fk_.MODE_POSE and kinematics.arm is None:
         # the poses pose_block solves have their exact branches, each within REACH_TOLERANCE;
         # the rest (out of reach, degenerate) goes through the general kernel (root search),
         # its roots packed into the pose layout
         # the rows by index: a boolean mask would be scanned whole by each of the ~10 uses
         distance = np.empty(n)
-        rest = np.flatnonzero(~_pose_fill(robot, target, reference, out, distance))
+        rest = np.flatnonzero(~_pose_fill(kinematics, target, reference, out, distance))
         reachable = np.ones(n, dtype=np.bool_)
         if rest.size:
             sub, ref = _rows(target, reference, rest)
             part = BranchSlots.empty(sub.poses.shape[0], 4 if slots == 4 else 4 * fk_.MAX_ROOTS)
-            _kernel(robot, sub, ref, part)
-            reachable[rest], distance[rest] = _general(robot, sub, part)
+            _kernel(kinematics, sub, ref, part)
+            reachable[rest], distance[rest] = _general(kinematics, sub, part)
             out.put(rest, pack_rolls(part, slots // 4))
     else:
-        if robot._arm is not None and target.kind != fk_.MODE_PITCH:
+        if kinematics.arm is not None and target.kind != fk_.MODE_PITCH:
             out.clear()
-            rest = ~al5_fill(robot, target, reference, out)
+            rest = ~al5_fill(kinematics, target, reference, out)
             if rest.any():
                 sub, ref = _rows(target, reference, rest)
                 part = out.rows(rest)
-                _kernel(robot, sub, ref, part)
+                _kernel(kinematics, sub, ref, part)
                 out.put(rest, part)
         else:
-            _kernel(robot, target, reference, out)
-        reachable, distance = _general(robot, target, out)
+            _kernel(kinematics, target, reference, out)
+        reachable, distance = _general(kinematics, target, out)
     q, valid, within, perr, oerr = out
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)
@@ -130,13 +132,15 @@ def pack_rolls(part: BranchSlots, rolls: int) -> BranchSlots:
     return BranchSlots(*(packed(array) for array in part))
 
 
-def _general(robot: Robot, target: Target, out: BranchSlots) -> tuple[np.ndarray, np.ndarray]:
+def _general(
+    kinematics: Kinematics, target: Target, out: BranchSlots
+) -> tuple[np.ndarray, np.ndarray]:
     """After the general kernel: the near-axis rescue, then which targets are reachable (N,)
     bool and their distance (N,) [m] (the smallest branch position error); a reachable target's
     solutions are the branches that reach it (the others are dropped from ``out``)."""
     from lynxplan.robots.selection import REACH_TOLERANCE
 
-    rescue_near_axis(robot, target, out)
+    rescue_near_axis(kinematics, target, out)
     distance = np.where(out.valid, out.position_error, np.inf).min(axis=1)
     reachable = distance <= REACH_TOLERANCE
     out.valid[...] &= ~(reachable[:, None] & (out.position_error > REACH_TOLERANCE))
@@ -154,7 +158,7 @@ RESCUE_SEED = 5
 ROLL_NUDGES = (-0.8, -0.4, -0.2, -0.1, 0.1, 0.2, 0.4, 0.8)
 
 
-def rescue_near_axis(robot: Robot, target: Target, out: BranchSlots) -> None:
+def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -> None:
     """Near-family models (off-axis tool): Levenberg-Marquardt on the exact chain adds the
     branches the ideal model misses. Full poses near the yaw axis with no exact branch: from
     each branch and fixed random starts. Approach targets with the roll free and no exact
@@ -165,14 +169,14 @@ def rescue_near_axis(robot: Robot, target: Target, out: BranchSlots) -> None:
     from lynxplan.robots.ik.numerical import numerical_ik_kernel
 
     q, valid, within, perr, oerr = out
-    family = robot.family
+    family = kinematics.family
     assert family is not None
     if family.exact or family.tool_on_roll_axis or target.kind == fk_.MODE_PITCH:
         return
     exact_count = np.count_nonzero(valid & (oerr <= 1e-9), axis=1)
     if exact_count.all():  # every target has an exact branch: nothing to rescue
         return
-    lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
+    lower, upper = kinematics.lower.copy(), kinematics.upper.copy()
     approach_only = target.kind == fk_.MODE_APPROACH
     if approach_only:
         # near-double roots of the approach equation split differently on the exact model:
@@ -207,8 +211,8 @@ def rescue_near_axis(robot: Robot, target: Target, out: BranchSlots) -> None:
         p_err, o_err = np.empty(n), np.empty(n)
         iterations = np.empty(n, dtype=np.int64)
         numerical_ik_kernel(
-            robot.chain.placements,
-            robot.chain.axes,
+            kinematics.chain.placements,
+            kinematics.chain.axes,
             np.repeat(target.poses[row : row + 1], n, 0),
             approach_only,
             lower,
@@ -234,14 +238,16 @@ def rescue_near_axis(robot: Robot, target: Target, out: BranchSlots) -> None:
             perr[row, slot], oerr[row, slot] = p_err[i], o_err[i]
 
 
-def _kernel(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots) -> None:
-    family = robot.family
+def _kernel(
+    kinematics: Kinematics, target: Target, reference: np.ndarray, out: BranchSlots
+) -> None:
+    family = kinematics.family
     assert family is not None
     miss = np.empty(out.valid.shape)
     fk_.family_ik_kernel(
         family.packed,
-        robot.chain.placements,
-        robot.chain.axes,
+        kinematics.chain.placements,
+        kinematics.chain.axes,
         kernel_input(target.poses),
         target.kind,
         kernel_input(target.pitch),
@@ -253,19 +259,19 @@ def _kernel(robot: Robot, target: Target, reference: np.ndarray, out: BranchSlot
 
 
 def solve_pose_one(
-    robot: Robot, pose: Any, reference: np.ndarray, verify: bool
+    kinematics: Kinematics, pose: Any, reference: np.ndarray
 ) -> RobotIkResult | None:
     """One full pose (4, 4) with the roll free, the lean way (one kernel call, no batch
     arrays; the AL5 through ``Arm.ik``): the result, or None where the pose needs the general
     path (not finite or rigid, out of reach, degenerate). ``reference`` (n,) [rad]."""
     pose = np.ascontiguousarray(pose, dtype=float)
-    if robot._arm is not None:
-        return solve_al5_pose_one(robot, pose, reference, verify)
-    family = robot.family
+    if kinematics.arm is not None:
+        return solve_al5_pose_one(kinematics, pose, reference)
+    family = kinematics.family
     assert family is not None
     slots = 4 if family.tool_on_roll_axis else 4 * POSE_ROLLS
     table = np.empty((slots, _pk.SLOT_COLUMNS))
-    chain = robot.chain
+    chain = kinematics.chain
     count = _pk.pose_one(
         family.packed,
         chain.placements,
@@ -282,7 +288,6 @@ def solve_pose_one(
     names = branch_names(slots)
     errors = [row[_pk.COMPACT_POSITION_ERROR] for row in rows]
     return assemble_result(
-        robot,
         q,
         [names[int(row[_pk.SLOT])] for row in rows],
         [row[_pk.COMPACT_WITHIN] != 0.0 for row in rows],
@@ -291,25 +296,29 @@ def solve_pose_one(
         True,
         min(errors),
         reference,
-        verify,
+        kinematics.solver_name,
     )
 
 
 def _pose_fill(
-    robot: Robot, target: Target, reference: np.ndarray, out: BranchSlots, distance: np.ndarray
+    kinematics: Kinematics,
+    target: Target,
+    reference: np.ndarray,
+    out: BranchSlots,
+    distance: np.ndarray,
 ) -> np.ndarray:
     """Full poses the orientation solves in closed form (``pose_kernel``; from a block of poses
     on, its vectorised form ``pose_block``); returns which. The others (out of reach,
     degenerate, a given roll) need the general kernel (root search). distance (N,): output,
     each target's smallest position error over its slots [m]."""
-    family = robot.family
+    family = kinematics.family
     assert family is not None
     solved = np.empty(target.poses.shape[0], dtype=np.bool_)
     kernel = pose_block_kernel if target.poses.shape[0] >= BLOCK else _pk.pose_kernel
     kernel(
         family.packed,
-        robot.chain.placements,
-        robot.chain.axes,
+        kinematics.chain.placements,
+        kinematics.chain.axes,
         kernel_input(target.poses),
         kernel_input(reference),
         *out,

@@ -10,14 +10,15 @@ from lynxplan.robots.ik import numerical as num
 from lynxplan.robots.results import RobotIkBatch
 
 if TYPE_CHECKING:
-    from lynxplan.robots.robot import Robot, Target
+    from lynxplan.robots.ik.description import Kinematics
+    from lynxplan.robots.targets import Target
 
 #: Seed of the deterministic multi-start configurations.
 START_SEED = 20240613
 
 
 def solve_numerical(
-    robot: Robot, target: Target, reference: np.ndarray, starts: int = num.DEFAULT_STARTS
+    kinematics: Kinematics, target: Target, reference: np.ndarray, starts: int = num.DEFAULT_STARTS
 ) -> RobotIkBatch:
     """Levenberg-Marquardt multi-start IK of each target (position + orientation or approach)."""
     from lynxplan.exceptions import TargetError
@@ -25,18 +26,18 @@ def solve_numerical(
     if target.kind == 2:
         raise TargetError("pitch targets need a yaw-pitch-pitch-pitch-roll arm")
     n = target.poses.shape[0]
-    lower, upper = robot.limits.lower.copy(), robot.limits.upper.copy()
+    lower, upper = kinematics.lower.copy(), kinematics.upper.copy()
     finite_lower = np.where(np.isfinite(lower), lower, -np.pi)
     finite_upper = np.where(np.isfinite(upper), upper, np.pi)
     rng = np.random.default_rng(START_SEED)
-    seeds = rng.uniform(finite_lower, finite_upper, size=(starts, robot.nq))
-    q = np.empty((n, robot.nq))
+    seeds = rng.uniform(finite_lower, finite_upper, size=(starts, kinematics.nq))
+    q = np.empty((n, kinematics.nq))
     success = np.empty(n, dtype=np.bool_)
     perr, oerr = np.empty(n), np.empty(n)
     iterations = np.empty(n, dtype=np.int64)
     num.numerical_ik_kernel(
-        robot.chain.placements,
-        robot.chain.axes,
+        kinematics.chain.placements,
+        kinematics.chain.axes,
         target.poses,
         target.kind == 1,
         lower,
