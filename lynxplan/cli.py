@@ -76,6 +76,7 @@ COMMAND_OF: dict[str, str] = {
     "robots": "lynxplan.commands.robots",
     "robot": "lynxplan.commands.robots",
     "compile": "lynxplan.commands.compile",
+    "lerobot": "lynxplan.commands.lerobot",
 }
 #: Every sub-command module, in the order of ``lynxplan --help``.
 COMMAND_MODULES = tuple(dict.fromkeys(COMMAND_OF.values()))
