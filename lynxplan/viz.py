@@ -369,9 +369,11 @@ def _camera(
     path: list[np.ndarray],
     plane: WritingPlane | None,
 ) -> tuple[np.ndarray, np.ndarray]:
-    """Camera position and orbit target: as given, or framed on the pen path (else the arm):
-    the whole path and the arm's base in view, seen along the writing plane's normal tilted
-    towards the base (or from 40 deg above the base's side without a plane)."""
+    """Camera position and orbit target (``joints``: the joint frames (njoints, 4, 4) at the
+    first frame): as given, or framed on the pen path (else the arm):
+    the whole path and the arm's joints (first frame) in view, seen from beside the line from
+    the base to the path (70 deg about z), 63 deg above the writing plane (40 deg above the
+    floor without a plane)."""
     if position is not None:
         eye = _camera_position(position)
         centre = np.zeros(3) if target is None else _camera_position(target, "camera_target")
@@ -380,24 +382,24 @@ def _camera(
     centre = 0.5 * (task.min(axis=0) + task.max(axis=0))
     if target is not None:
         centre = _camera_position(target, "camera_target")
-    base = joints[0, :3, 3]
+    base = joints[min(1, len(joints) - 1), :3, 3]  # the first joint's origin
     towards_base = np.append(base[:2] - centre[:2], 0.0)
     towards_base /= max(float(np.linalg.norm(towards_base)), 1e-9)
     if not np.linalg.norm(base[:2] - centre[:2]) > 1e-6:
         towards_base = np.array([0.0, -1.0, 0.0])
-    # From the base's side, turned 30 deg about z (the arm does not hide the path).
-    c, s = np.cos(np.radians(30.0)), np.sin(np.radians(30.0))
+    # From beside the line base-task (turned 70 deg about z): the arm does not hide the path.
+    c, s = np.cos(np.radians(70.0)), np.sin(np.radians(70.0))
     side = np.array(
         [c * towards_base[0] - s * towards_base[1], s * towards_base[0] + c * towards_base[1], 0.0]
     )
     if plane is not None:
         normal = np.asarray(plane.normal, float) / np.linalg.norm(plane.normal)
         up = normal if normal[2] >= 0 else -normal
-        direction = up + 0.8 * side
+        direction = up + 0.5 * side  # 63 deg above the plane
     else:
         direction = side + np.array([0.0, 0.0, np.tan(np.radians(40.0))])
     direction = direction / np.linalg.norm(direction)
-    radius = float(np.linalg.norm(np.vstack([task, base]) - centre, axis=1).max())
+    radius = float(np.linalg.norm(np.vstack([task, joints[:, :3, 3]]) - centre, axis=1).max())
     distance = 1.35 * max(radius, 0.05) / np.tan(np.radians(CAMERA_FOV_DEG) / 2.0)
     return centre + distance * direction, centre
 
