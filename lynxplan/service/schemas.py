@@ -46,7 +46,9 @@ class TrajectoryRequest(BaseModel):
     robot: str = "al5"
     waypoints: list[list[float]] = Field(description="(M, 5), in rad, M >= 2.")
     method: Literal["lspb", "ruckig", "toppra"] = "lspb"
-    rate: float = Field(100.0, description="Sample rate, in Hz.")
+    rate: float = Field(
+        100.0, description="Sample rate, in Hz (1 to 10000; duration x rate is bounded: 413)."
+    )
     timing: dict[str, float] | None = Field(None, description="{tt, ta} in s (lspb only).")
     limits: dict[str, Any] | None = Field(None, description="{velocity, acceleration, jerk}.")
 
@@ -60,7 +62,12 @@ class PlanRequest(BaseModel):
     obstacles: list[dict[str, Any]] = Field(default_factory=list, description="As /check.")
     seed: int = 0
     time_limit: float = Field(1.0, description="Planning budget, in s (at most 30).")
-    options: dict[str, Any] | None = Field(None, description="PlannerOptions fields.")
+    options: dict[str, Any] | None = Field(
+        None,
+        description="PlannerOptions fields: clearance [0, 1] m, step [1e-4, 10] rad, goal_bias, "
+        "max_nodes <= 1e6, shortcut_iterations, shortcut_patience, timing, max_acceleration and "
+        "max_jerk (a number or 5, > 0), sample_rate [1, 10000] Hz.",
+    )
 
 
 class Scenario(BaseModel):

@@ -14,6 +14,7 @@ from __future__ import annotations
 import asyncio
 import contextlib
 import multiprocessing
+import os
 import threading
 import time
 from typing import Any
@@ -28,6 +29,9 @@ MAX_WAITING = 64
 DISCONNECT_POLL = 0.1
 #: Seconds a new worker may take to import, load the robots and report ready.
 START_TIMEOUT = 180.0
+#: Scheduling niceness of the compute workers: their warm-up and long computations yield the
+#: cores to the server process, whose hot routes (/ik, /fk) keep their latency.
+WORKER_NICENESS = 10
 
 
 def _worker_main(connection: Any, memory_limit: int) -> None:
@@ -35,6 +39,8 @@ def _worker_main(connection: Any, memory_limit: int) -> None:
     from lynxplan.service import compute
 
     _exit_with_parent()
+    with contextlib.suppress(OSError):
+        os.nice(WORKER_NICENESS)  # the server's hot routes keep their latency under heavy work
     if memory_limit > 0:
         import resource
 
@@ -53,8 +59,6 @@ def _exit_with_parent() -> None:
     """Exit when the server process dies (even by kill -9, even mid-task): a thread watches
     the parent's pid. (PR_SET_PDEATHSIG would fire when the *thread* that started the worker
     ends, and workers are started from short-lived threads.)"""
-    import os
-
     parent = os.getppid()
 
     def watch() -> None:
@@ -206,12 +210,14 @@ class ComputePool:
             return
 
         def restart() -> None:
+            delay = 1.0
             while not self._closed:
                 try:
                     worker.ensure()
                     break
-                except RuntimeError:
-                    time.sleep(1.0)
+                except RuntimeError:  # e.g. a memory limit too small to import: back off
+                    time.sleep(delay)
+                    delay = min(2 * delay, 60.0)
             if not self._closed and self._idle is not None:
                 loop.call_soon_threadsafe(self._idle.put_nowait, worker)
 
