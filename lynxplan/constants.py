@@ -16,9 +16,11 @@ BASE_AXIS_TOLERANCE = 1e-9
 #: Default accepted orientation residual for strict IK, in [rad].
 STRICT_ORIENTATION_TOLERANCE = 1e-6
 
-#: A wrist centre up to this far outside the reachable annulus is pulled onto it, in [m]
-#: (poses typed from a 4-decimal inch printout are off by ~1e-6 m); further is out of reach.
-REACH_TOLERANCE = 1e-6
+#: The AL5 kernels of :mod:`lynxplan.arm`: a wrist centre up to this far outside the reachable
+#: annulus is pulled onto it, in [m] (poses typed from a 4-decimal inch printout are off by
+#: ~1e-6 m); further is out of reach. Not :data:`REACH_TOLERANCE` (a branch's position error,
+#: 1e-9 m): this one admits a typed pose, that one judges a computed branch.
+WRIST_SNAP_TOLERANCE = 1e-6
 
 #: Stationary (zero-length) segments chosen by auto-timing last this long, in [s].
 MIN_SEGMENT_DURATION = 1e-3
@@ -57,3 +59,80 @@ RESOLVED_RATE_MAX_TIME_FACTOR = 20.0
 #: GJK/EPA tolerance of the coal distance queries (coal's default 1e-6 leaves ~1e-6 m error on
 #: cylinders; this gives ~1e-9 m).
 COAL_GJK_TOLERANCE = 1e-9
+
+
+# -- inverse kinematics of serial arms (lynxplan.robots) -------------------------------------
+# Every tolerance of the IK solvers (the kernels read them as compile-time constants). Two
+# tolerances of different quantities keep different names, never one name with two values.
+
+#: The AL5 URDF's DH structure (rotations, zero offsets) must match to this, unitless / [m].
+URDF_STRUCTURE_TOLERANCE = 1e-9
+
+#: A branch reaches its target when FK puts the tool this close to the target position [m].
+REACH_TOLERANCE = 1e-9
+
+#: Target rotation blocks further than this from orthonormal are re-orthonormalised (up to the
+#: guards' repair tolerance; beyond it they are refused).
+ORTHONORMAL_TOLERANCE = 1e-12
+
+#: Largest angle by which a URDF's axes may miss parallel/perpendicular and still count as the
+#: yaw-pitch-pitch-pitch-roll family [rad].
+FAMILY_AXIS_TOLERANCE = 1e-3
+
+#: Deviations below this count as exact (no polishing on the exact model needed) [rad].
+FAMILY_EXACT_TOLERANCE = 1e-12
+
+#: A tool point closer than this to the roll axis is on it [m].
+ON_AXIS_TOLERANCE = 1e-12
+
+#: Newton polish of a family branch on the exact chain (``family_polish``: roll search,
+#: approach and pitch targets, near-family models): it stops once the largest of its five
+#: conditions (position [m], in-plane and roll conditions [1]) is below this, and a tentative
+#: root is a branch only if its polish gets there.
+POLISH_CONDITION_TOLERANCE = 1e-14
+
+#: Gauss-Newton polish of a full-pose branch (``pose_kernel``, ``pose_block``): it stops once the
+#: largest component of the 6-vector pose error (position [m], small rotation [rad]) is below
+#: this. Not :data:`POLISH_CONDITION_TOLERANCE`: another quantity, and one ulp-level step of
+#: either changes the last bits of the branches the tests and benchmarks pin.
+POSE_POLISH_TOLERANCE = 1e-15
+
+#: A branch reaches a full pose exactly within this position [m] and orientation [rad] error.
+POSE_EXACT = 1e-9
+
+#: A single-pose IK target whose rotation block is this close to orthonormal (and the last row
+#: to 0 0 0 1) is taken as it is (``pose_kernel.pose_one``).
+RIGID_TOLERANCE = 1e-12
+
+#: A candidate is taken by the vector path when its final position [m] and orientation [rad]
+#: errors are both below this; otherwise it is rejected (below) or finished by the scalar polish.
+VECTOR_EXACT = 1e-14
+
+#: Two branches closer than this in every joint are one [rad].
+BRANCH_DUPLICATE_TOLERANCE = 1e-9
+
+#: The held polish must reach the position and in-plane conditions this closely [m], [1]
+#: (next to a fold of the elbow Newton converges only linearly; the roots are polished again);
+#: otherwise the branch does not exist at this roll and the equation is undefined (NaN).
+HELD_TOLERANCE = 1e-9
+
+#: A numerical IK solution (``robots/ik/numerical``) must reach the target position within this
+#: [m] ...
+NUMERICAL_POSITION_TOLERANCE = 1e-10
+
+#: ... and the target orientation (or approach axis) within this [rad].
+NUMERICAL_ORIENTATION_TOLERANCE = 1e-9
+
+#: A local extremum of the roll equation this close to zero is a double root (f is the sine of
+#: a roll mismatch or an axis component: 1e-10 means 1e-10 rad).
+TANGENT_TOLERANCE = 1e-10
+
+#: Roots where the tool point misses the yaw circle by more than this [m] are not solutions
+#: (more than the ~1e-7 m the exact model differs from the ideal one by).
+CLAMPED_ROOT_TOLERANCE = 1e-6
+
+#: Roots of the exact equation are refined until a step is below this [rad].
+EXACT_ROOT_STEP = 1e-9
+
+#: The reach boundary of an exact branch is located to this [rad].
+BOUNDARY_TOLERANCE = 1e-7

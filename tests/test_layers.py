@@ -170,3 +170,22 @@ def test_the_ik_solvers_never_import_the_robot():
     assert "lynxplan.robots.ik.family_solver" in solvers
     offenders = [name for name in solvers if "lynxplan.robots.robot" in graph[name]]
     assert not offenders, offenders
+
+
+def test_every_ik_tolerance_is_named_once_in_lynxplan_constants():
+    """The IK packages (robots, arm) define no tolerance of their own: each is a named constant
+    of :mod:`lynxplan.constants` (one name, one value; two values are two names)."""
+    own = {
+        f"{path.relative_to(PACKAGE)}: {target.id}"
+        for folder in ("robots", "arm")
+        for path in (PACKAGE / folder).rglob("*.py")
+        for node in ast.parse(path.read_text(encoding="utf-8")).body
+        if isinstance(node, ast.Assign) and isinstance(node.value, ast.Constant)
+        for target in node.targets
+        if isinstance(target, ast.Name) and "TOLERANCE" in target.id
+    }
+    assert not own, sorted(own)
+    from lynxplan import constants
+
+    assert constants.REACH_TOLERANCE == 1e-9  # a computed branch reaches its target
+    assert constants.WRIST_SNAP_TOLERANCE == 1e-6  # a typed AL5 pose is admitted

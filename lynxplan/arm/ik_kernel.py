@@ -14,7 +14,7 @@ import numba
 import numpy as np
 
 from lynxplan._fastmath import atan2, sincos
-from lynxplan.constants import BASE_AXIS_TOLERANCE, REACH_TOLERANCE, RIGIDITY_REPAIR_TOLERANCE
+from lynxplan.constants import BASE_AXIS_TOLERANCE, RIGIDITY_REPAIR_TOLERANCE, WRIST_SNAP_TOLERANCE
 
 TWO_PI = 2.0 * math.pi
 #: IEEE-safe fast-math flags: fused multiply-add and division by reciprocal (rounding differs
@@ -80,7 +80,7 @@ class IkOutputs(NamedTuple):
 # Module constants read by the kernels (numba freezes globals at compile time).
 RIGIDITY_REPAIR_TOLERANCE_K = RIGIDITY_REPAIR_TOLERANCE
 BASE_AXIS_TOLERANCE_K = BASE_AXIS_TOLERANCE
-REACH_TOLERANCE_K = REACH_TOLERANCE
+WRIST_SNAP_TOLERANCE_K = WRIST_SNAP_TOLERANCE
 #: Elbow cosines this close to +-1 are +-1 (a straight or folded elbow).
 FOLD_SNAP_K = 1e-14
 #: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
@@ -309,7 +309,7 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         rigid = deviation <= RIGIDITY_REPAIR_TOLERANCE_K
         status = 2.0 if (status == 0.0) & (not rigid) else status
         admitted = status == 0.0
-        status = 1.0 if admitted & (not miss <= REACH_TOLERANCE_K) else status
+        status = 1.0 if admitted & (not miss <= WRIST_SNAP_TOLERANCE_K) else status
         solved = status == 0.0
         # Step 4: the four branches, wrapped into the limits, with their within-limit flags.
         # The back branch (plane direction reversed) follows from identities: q1 + pi,

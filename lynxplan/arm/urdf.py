@@ -15,11 +15,10 @@ from typing import Any
 import numpy as np
 
 from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
+from lynxplan.constants import URDF_STRUCTURE_TOLERANCE
 from lynxplan.exceptions import ModelError
 
 DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
-#: Tolerance on the URDF's DH structure (rotations, zero offsets), unitless / [m].
-_STRUCTURE_TOLERANCE = 1e-9
 
 
 def default_urdf_path() -> Path:
@@ -82,7 +81,7 @@ def read_geometry(model: Any) -> ArmGeometry:
     placements = [model.jointPlacements[i] for i in range(1, 6)]
     expected_rotations = (np.eye(3), rx90, np.eye(3), np.eye(3), rx90)
     for name, placement, rotation in zip(JOINT_NAMES, placements, expected_rotations, strict=True):
-        if not np.allclose(placement.rotation, rotation, atol=_STRUCTURE_TOLERANCE):
+        if not np.allclose(placement.rotation, rotation, atol=URDF_STRUCTURE_TOLERANCE):
             raise ModelError(f"joint {name}: placement rotation is not the DH model's")
     a2, a3 = placements[2].translation[0], placements[3].translation[0]
     tool = model.frames[model.getFrameId(TOOL_FRAME)].placement
@@ -90,7 +89,7 @@ def read_geometry(model: Any) -> ArmGeometry:
         [placements[i].translation for i in (0, 1, 4)]
         + [placements[2].translation[1:], placements[3].translation[1:], tool.translation[:2]]
     )
-    if not np.allclose(offsets, 0.0, atol=_STRUCTURE_TOLERANCE) or min(a2, a3) <= 0:
+    if not np.allclose(offsets, 0.0, atol=URDF_STRUCTURE_TOLERANCE) or min(a2, a3) <= 0:
         raise ModelError("joint placements do not follow the DH model of SPEC Part 1")
     for frame in (*DH_FRAMES, TOOL_FRAME):
         if not model.existFrame(frame):

@@ -22,12 +22,11 @@ from typing import Any
 
 import numpy as np
 
-#: Largest angle by which axes may miss parallel/perpendicular and still count as the family [rad].
-FAMILY_AXIS_TOLERANCE = 1e-3
-#: Deviations below this count as exact (no polishing on the exact model needed) [rad].
-FAMILY_EXACT_TOLERANCE = 1e-12
-#: A tool point closer than this to the roll axis is on it [m].
-ON_AXIS_TOLERANCE = 1e-12
+from lynxplan.constants import (
+    FAMILY_AXIS_TOLERANCE,
+    FAMILY_EXACT_TOLERANCE,
+    ON_AXIS_TOLERANCE,
+)
 
 # Layout of the packed parameter vector read by the numba kernels.
 C1, K, P, H, R = 0, 3, 6, 9, 12

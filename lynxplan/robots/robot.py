@@ -22,7 +22,10 @@ import numpy as np
 
 from lynxplan._arrays import kernel_input
 from lynxplan.arm.geometry import JointLimits
-from lynxplan.constants import LIMIT_SNAP_TOLERANCE
+from lynxplan.constants import (
+    LIMIT_SNAP_TOLERANCE,
+    REACH_TOLERANCE,
+)
 from lynxplan.exceptions import ShapeError, TargetError
 from lynxplan.robots import chain as _chain
 from lynxplan.robots.family import FamilyParameters, recognise_family
@@ -38,7 +41,9 @@ from lynxplan.robots.results import (
     RobotInfo,
     TrackResult,
 )
-from lynxplan.robots.selection import REACH_TOLERANCE, select_one
+from lynxplan.robots.selection import (
+    select_one,
+)
 from lynxplan.robots.targets import (
     KIND_APPROACH,
     KIND_PITCH,

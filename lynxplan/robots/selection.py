@@ -7,10 +7,8 @@ import math
 
 import numpy as np
 
+from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.robots.results import RobotIkBatch, RobotIkResult, RobotIkSolution
-
-#: A branch reaches its target when FK puts the tool this close to the target position [m].
-REACH_TOLERANCE = 1e-9
 
 
 def select_one(batch: RobotIkBatch, reference: np.ndarray, solver: str) -> RobotIkResult:

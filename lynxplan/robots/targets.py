@@ -6,6 +6,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan.constants import ORTHONORMAL_TOLERANCE
 from lynxplan.exceptions import NonFiniteInputError, ShapeError, TargetError
 
 KIND_POSE, KIND_APPROACH, KIND_PITCH = 0, 1, 2
@@ -27,11 +28,6 @@ def as_array(x: Any, name: str, shape_tail: tuple[int, ...]) -> np.ndarray:
     if not np.isfinite(array).all():
         raise NonFiniteInputError(name)
     return array.reshape((-1, *shape_tail))
-
-
-#: Rotation blocks further than this from orthonormal are re-orthonormalised (up to the guards'
-#: repair tolerance; beyond it they are refused).
-ORTHONORMAL_TOLERANCE = 1e-12
 
 
 def _rigid_poses(poses: Any) -> np.ndarray:

@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 
+from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.robots.ik.description import Kinematics
 from lynxplan.robots.ik.dispatch import solve
 from lynxplan.robots.results import TrackJump, TrackResult
-from lynxplan.robots.selection import REACH_TOLERANCE
 from lynxplan.robots.targets import Target
 
 #: ik_track flags a step whose largest joint change exceeds this [rad].

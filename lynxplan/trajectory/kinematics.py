@@ -21,6 +21,7 @@ from typing import Any, NamedTuple, Protocol
 
 import numpy as np
 
+from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.exceptions import InputError, PathNotFollowableError
 from lynxplan.trajectory.limits import MotionLimits
 
@@ -202,7 +203,6 @@ class RobotKinematics:
         return math.atan2(float(approach @ turned), -float(approach @ k))
 
     def _follow(self, batch: Any, q_before: np.ndarray, s: np.ndarray) -> PathIk:
-        from lynxplan.robots.selection import REACH_TOLERANCE
 
         ok = (
             batch.valid

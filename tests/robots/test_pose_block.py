@@ -15,7 +15,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lynxplan import constants
 from lynxplan._arrays import kernel_input
+from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.robots import Robot, load_robot
 from lynxplan.robots.ik import family_solver, pose_kernel
 from lynxplan.robots.ik.pose_block import pose_block_kernel
@@ -213,9 +215,8 @@ def test_exact_branches_are_within_the_reach_tolerance() -> None:
     """``solve_family`` returns the pose kernels' batch as it is when every target has exact
     branches: each reaches its target within REACH_TOLERANCE (so it is reachable, and no
     branch is dropped)."""
-    from lynxplan.robots.selection import REACH_TOLERANCE
 
-    assert pose_kernel.POSE_EXACT <= REACH_TOLERANCE
+    assert constants.POSE_EXACT <= REACH_TOLERANCE
     robot = load_robot("so101")
     batch = robot.ik_batch(robot.fk(robot.random_configurations(300, seed=9)))
     assert batch.reachable.all()

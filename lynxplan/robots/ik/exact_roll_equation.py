@@ -16,6 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from lynxplan.constants import HELD_TOLERANCE
 from lynxplan.robots.ik.family_geometry import ChainProblem, RollProblem, branch
 from lynxplan.robots.ik.family_polish import conditions, polish
 
@@ -25,10 +26,6 @@ ExactProblem = tuple[
     RollProblem, ChainProblem, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
 ]
 
-#: The held polish must reach the position and in-plane conditions this closely [m], [1]
-#: (next to a fold of the elbow Newton converges only linearly; the roots are polished again);
-#: otherwise the branch does not exist at this roll and the equation is undefined (NaN).
-HELD_TOLERANCE = 1e-9
 #: Where the ideal branch misses the target by more than this [m] the exact one (~1e-7 m away)
 #: cannot reach it either: undefined without a polish.
 REACH_MARGIN = 1e-6

@@ -19,6 +19,7 @@ import math
 import numba
 import numpy as np
 
+from lynxplan.constants import BRANCH_DUPLICATE_TOLERANCE, POLISH_CONDITION_TOLERANCE
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
@@ -28,7 +29,6 @@ from lynxplan.robots.ik.family_geometry import (
     branch,
 )
 from lynxplan.robots.ik.family_polish import (
-    NEWTON_TOLERANCE,
     branch_orientation_error,
     is_duplicate,
     polish,
@@ -53,9 +53,6 @@ __all__ = [
     "ROOT_GRID",
     "family_ik_kernel",
 ]
-
-#: Two branches closer than this in every joint are one [rad].
-DUPLICATE_TOLERANCE = 1e-9
 
 
 @numba.njit(cache=True, nogil=True)
@@ -203,7 +200,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         # a tentative root: a branch only if Newton converges on the exact model
                         if (
                             polish(chain_problem, np.nan, q, scratch, scratch4, scratch5)
-                            >= NEWTON_TOLERANCE
+                            >= POLISH_CONDITION_TOLERANCE
                         ):
                             firm = 0
                             for j in range(count):
@@ -219,7 +216,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         trial[:] = q
                         if (
                             polish(chain_problem, np.nan, trial, scratch, scratch4, scratch5)
-                            < NEWTON_TOLERANCE
+                            < POLISH_CONDITION_TOLERANCE
                         ):
                             q[:] = trial
                             polished = True
@@ -237,7 +234,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         polish(chain_problem, rg, q, scratch, scratch4, scratch5)
                     inside, err = settle(placements, axes, lower, upper, tol, target, q, pose, work)
                     # the same branch reached twice (merged roots, a fold)
-                    if is_duplicate(q_out[n], valid[n], b, q, DUPLICATE_TOLERANCE):
+                    if is_duplicate(q_out[n], valid[n], b, q, BRANCH_DUPLICATE_TOLERANCE):
                         continue
                     for j in range(5):
                         q_out[n, b, j] = q[j]

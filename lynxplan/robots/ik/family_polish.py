@@ -13,6 +13,7 @@ import numba
 import numpy as np
 
 from lynxplan.arm.ik_kernel import wrap_into_limits
+from lynxplan.constants import POLISH_CONDITION_TOLERANCE
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
 from lynxplan.robots.ik.family_geometry import (
@@ -23,9 +24,8 @@ from lynxplan.robots.ik.family_geometry import (
     rotate,
 )
 
-#: Newton iterations at most, and the largest condition at which it stops.
+#: Newton iterations at most (it stops below ``constants.POLISH_CONDITION_TOLERANCE``).
 NEWTON_STEPS = 40
-NEWTON_TOLERANCE = 1e-14
 #: The chord method keeps its Jacobian while each step divides the conditions by 1 / CHORD_RATE.
 CHORD_RATE = 1e-3
 #: Finite-difference step of the Jacobian of the conditions [rad].
@@ -172,7 +172,7 @@ def polish(
     norm = first
     factored = fresh = False
     for _ in range(NEWTON_STEPS):
-        if norm < NEWTON_TOLERANCE or not math.isfinite(norm):
+        if norm < POLISH_CONDITION_TOLERANCE or not math.isfinite(norm):
             break
         if not factored:
             for j in range(5):

@@ -11,6 +11,7 @@ import numpy as np
 
 from lynxplan import _jit
 from lynxplan._arrays import kernel_input
+from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
@@ -138,8 +139,6 @@ def _general(
     """After the general kernel: the near-axis rescue, then which targets are reachable (N,)
     bool and their distance (N,) [m] (the smallest branch position error); a reachable target's
     solutions are the branches that reach it (the others are dropped from ``out``)."""
-    from lynxplan.robots.selection import REACH_TOLERANCE
-
     rescue_near_axis(kinematics, target, out)
     distance = np.where(out.valid, out.position_error, np.inf).min(axis=1)
     reachable = distance <= REACH_TOLERANCE

@@ -14,12 +14,12 @@ import math
 import numba
 import numpy as np
 
+from lynxplan.constants import (
+    NUMERICAL_ORIENTATION_TOLERANCE,
+    NUMERICAL_POSITION_TOLERANCE,
+)
 from lynxplan.robots.chain import chain_fk_jacobian
 
-#: A numerical solution must reach the target position within this [m].
-NUMERICAL_POSITION_TOLERANCE = 1e-10
-#: ... and the target orientation (or approach axis) within this [rad].
-NUMERICAL_ORIENTATION_TOLERANCE = 1e-9
 MAX_ITERATIONS = 200
 DEFAULT_STARTS = 128
 

@@ -48,13 +48,16 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 from lynxplan import _fastmath
 from lynxplan._fastmath import prefetch, prefetch_write, wide_vectors
 from lynxplan.arm.ik_kernel import wrap_into_limits
+from lynxplan.constants import (
+    BRANCH_DUPLICATE_TOLERANCE,
+    POSE_EXACT,
+    VECTOR_EXACT,
+)
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
-from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
 from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
 from lynxplan.robots.ik.pose_kernel import (
     AXIAL_APPROACH,
-    POSE_EXACT,
     REACH_MISS,
     SLOT_COLUMNS,
     polish_pose,
@@ -79,9 +82,6 @@ sincos = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.sincos.py_func)
 atan2 = numba.njit(nogil=True, fastmath=_FAST)(_fastmath.atan2.py_func)
 #: Poses per block (a constant width: the scratch rows never alias, see ``arm.ik_kernel``).
 BLOCK = 32
-#: A candidate is taken by the vector path when its final position [m] and orientation [rad]
-#: errors are both below this; otherwise it is rejected (below) or finished by the scalar polish.
-VECTOR_EXACT = 1e-14
 #: A candidate whose final position [m] or orientation [rad] error is above NOT_A_BRANCH and has
 #: stopped falling (at least STALLED times the error before the last step) is not an exact
 #: branch: the orientation is out of reach on that flip, and the steps end at the residual of the
@@ -1393,7 +1393,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     gap = 0.0
                     for j in range(5):
                         gap = max(gap, abs(c[_C_Q + j, ka] - c[_C_Q + j, kb]))
-                    pair = gap >= DUPLICATE_TOLERANCE  # else kb is a duplicate
+                    pair = gap >= BRANCH_DUPLICATE_TOLERANCE  # else kb is a duplicate
                     for h in range(2 if pair else 1):
                         k = kb if h else ka
                         b = slot_of[k]
@@ -1437,7 +1437,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     for j in range(5):
                         qs[j] = c[_C_Q + j, k]
                     inside, err, angle = c[_C_IN, k] != 0.0, c[_C_PERR, k], c[_C_OERR, k]
-                if is_duplicate(taken, _ALL_TAKEN, count, qs, DUPLICATE_TOLERANCE):
+                if is_duplicate(taken, _ALL_TAKEN, count, qs, BRANCH_DUPLICATE_TOLERANCE):
                     continue
                 for j in range(5):
                     q_out[n, b, j] = qs[j]

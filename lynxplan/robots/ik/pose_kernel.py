@@ -24,10 +24,15 @@ import math
 import numba
 import numpy as np
 
+from lynxplan.constants import (
+    BRANCH_DUPLICATE_TOLERANCE,
+    POSE_EXACT,
+    POSE_POLISH_TOLERANCE,
+    RIGID_TOLERANCE,
+)
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
 from lynxplan.robots.ik.family_geometry import MODE_POSE, best_roll, branch, pitch_sum, wrap, yaw
-from lynxplan.robots.ik.family_kernel import DUPLICATE_TOLERANCE
 from lynxplan.robots.ik.family_polish import (
     is_duplicate,
     lu_factor,
@@ -36,8 +41,6 @@ from lynxplan.robots.ik.family_polish import (
     settle,
 )
 
-#: A branch reaches a full pose exactly within this position [m] and orientation [rad] error.
-POSE_EXACT = 1e-9
 #: The yaw one side of the lateral offset gives must match the orientation's within this [rad],
 #: plus YAW_MATCH_LENGTH / (distance from the yaw axis) (the ideal model's tool point differs
 #: from the exact chain's by ~1e-6 m for the SO-101, which turns the yaw more near the axis),
@@ -72,9 +75,9 @@ def yaw_match(deviation: float, reach: float, axial: float, rho: float, lateral:
     return min(max(YAW_MATCH, axial_part) + YAW_MATCH_LENGTH / max(rho, 1e-12), moved)
 
 
-#: Gauss-Newton iterations of the polish at most, and the pose error at which it stops.
+#: Gauss-Newton iterations of the polish at most (it stops below
+#: ``constants.POSE_POLISH_TOLERANCE``).
 NEWTON_STEPS = 60
-NEWTON_TOLERANCE = 1e-15
 #: An iteration must divide the error by at least this much, or the polish stops: from a
 #: closed-form start it falls quadratically (1e-6, 1e-12, ...), next to a fold of the elbow
 #: (a double root: the error ~ the square of the joint gap, which Newton halves) by ~4 per
@@ -137,7 +140,7 @@ def polish_pose(  # noqa: PLR0912 (numba: one compiled loop)
         size = 0.0
         for i in range(6):
             size = max(size, abs(e[i]))
-        if size < NEWTON_TOLERANCE:
+        if size < POSE_POLISH_TOLERANCE:
             return True
         if not size * MIN_FALL <= previous:
             worse = not size <= previous
@@ -278,7 +281,7 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                 angle = rotation_angle(target, pose)
                 if not (err <= POSE_EXACT and angle <= POSE_EXACT):
                     continue
-                if is_duplicate(out, out[:, VALID], nb, q, DUPLICATE_TOLERANCE):
+                if is_duplicate(out, out[:, VALID], nb, q, BRANCH_DUPLICATE_TOLERANCE):
                     continue
                 for j in range(5):
                     out[b, j] = q[j]
@@ -288,10 +291,6 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                 out[b, ORIENTATION_ERROR] = angle
                 solved = True
     return solved
-
-
-#: A rotation block this close to orthonormal (and the last row to 0 0 0 1) is taken as it is.
-RIGID_TOLERANCE = 1e-12
 
 
 @numba.njit(cache=True, nogil=True)

@@ -17,6 +17,12 @@ import numba
 import numpy as np
 from numba.extending import overload
 
+from lynxplan.constants import (
+    BOUNDARY_TOLERANCE,
+    CLAMPED_ROOT_TOLERANCE,
+    EXACT_ROOT_STEP,
+    TANGENT_TOLERANCE,
+)
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.exact_roll_equation import (
     ExactProblem,
@@ -40,12 +46,6 @@ FAST_CHANGE = 0.25
 BOUNDARY_SAMPLES = 32
 #: Near-roots of the ideal model (|f| below this at a local extremum) are tried on the exact one.
 NEAR_ROOT = 5e-3
-#: A local extremum of the roll equation this close to zero is a double root (f is the sine of
-#: a roll mismatch or an axis component: 1e-10 means 1e-10 rad).
-TANGENT_TOLERANCE = 1e-10
-#: Roots where the tool point misses the yaw circle by more than this [m] are not solutions
-#: (more than the ~1e-7 m the exact model differs from the ideal one by).
-CLAMPED_ROOT_TOLERANCE = 1e-6
 #: At most this many roll roots per side are kept (each gives two elbow branches).
 MAX_ROOTS = 6
 #: Grid samples of one side at most (uniform points, subdivisions, boundary samples).
@@ -59,10 +59,6 @@ EXACT_BAND = 16.0
 #: Roots of the two elbows' exact equations closer than this are one root [rad] (each elbow's
 #: branch is then polished from it).
 ROOT_MERGE = 1e-6
-#: Roots of the exact equation are refined until a step is below this [rad].
-EXACT_ROOT_STEP = 1e-9
-#: The reach boundary of an exact branch is located to this [rad].
-BOUNDARY_TOLERANCE = 1e-7
 
 
 def equation(problem: RollProblem | ExactProblem, theta: float) -> float:
