@@ -31,6 +31,7 @@ SECTIONS: dict[str, str] = {
     "plan": "lynxplan.bench.plan",
     "serve": "lynxplan.bench.serve",
     "robots": "lynxplan.bench.robots",
+    "suite": "lynxplan.bench.suite",
 }
 
 

@@ -57,6 +57,9 @@ def register(subparsers: Any) -> None:
     )
     group.add_argument("--urdf", help="IK figures of this URDF robot only (with --tool)")
     parser.add_argument("--tool", help="tool frame of --robot/--urdf (default: the robot's tool)")
+    from lynxplan.benchsuite.command import add_arguments as add_suite_arguments
+
+    add_suite_arguments(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -66,6 +69,10 @@ def handle(args: argparse.Namespace) -> int:
     if unknown:
         raise InputError(f"unknown bench section {unknown[0]!r}; sections: {', '.join(SECTIONS)}")
     sections = ["cold"] if args.cold else (args.section or []) + args.sections or None
+    if sections == ["suite"]:  # SmallArmBench: its own table, plot and options
+        from lynxplan.benchsuite.command import run_suite
+
+        return run_suite(args)
     if args.robot or args.urdf or args.tool:
         if sections or args.cold:
             raise InputError("--robot/--urdf/--tool run the robot section alone; drop the sections")

@@ -1,0 +1,120 @@
+"""OMPL and pyroboplan on SmallArmBench problems, side by side with lynxplan.
+
+Each peer runs from its own virtual environment (:mod:`lynxplan.bench.peers`: ``ompl`` and
+``pyroboplan`` under ``LYNXPLAN_PEERS_DIR``), on the same start, goal configuration and boxes,
+with a Pinocchio/coal collision model of the robot's URDF (boolean checks at a joint
+resolution of :data:`PEER_RESOLUTION`); its paths are checked by the same dense check as
+lynxplan's. OMPL's validity checker is a Python callback: its share of OMPL's time and its
+number of calls are reported. A peer that is not installed says so.
+"""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import tempfile
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from lynxplan.benchsuite.problem import Problem, suite_robot, yaw_rotation
+from lynxplan.benchsuite.runner import TIME_LIMIT, ProblemResult, dense_check
+
+#: Peers' joint resolution of edge checks, in [rad]; the issue's speed-up goal over OMPL.
+PEER_RESOLUTION, GOAL_SPEEDUP = 0.005, 50.0
+_SCRIPTS = {
+    "ompl": Path(__file__).parent / "peer_scripts" / "ompl_timed.py",
+    "pyroboplan": Path(__file__).parents[1] / "bench" / "peers" / "pyroboplan_rrt.py",
+}
+
+
+def _spec(problems: Sequence[Problem]) -> dict[str, Any]:
+    return {
+        "urdf": str(suite_robot(problems[0].robot).urdf_path),
+        "seeds": [0],
+        "resolution": PEER_RESOLUTION,
+        "time_limit": TIME_LIMIT,
+        "simplify": True,
+        "problems": [
+            {"name": p.name, "start": p.start.tolist(), "goals": [p.goal.tolist()],
+             "obstacles": [{"name": n, "type": "box", "centre": c.tolist(), "size": s.tolist(),
+                            "rotation": yaw_rotation(float(y)).tolist()}
+                           for n, c, s, y in zip(p.names, p.centres, p.sizes, p.yaws,
+                                                 strict=True)]}
+            for p in problems
+        ],
+    }  # fmt: skip
+
+
+def _run(peer: str, spec: dict[str, Any]) -> list[dict[str, Any]]:
+    from lynxplan.bench.peers import peer_python
+
+    with tempfile.TemporaryDirectory() as folder:
+        output = Path(folder) / "rows.json"
+        done = subprocess.run(
+            [str(peer_python(peer)), str(_SCRIPTS[peer]), str(output)],
+            input=json.dumps(spec), capture_output=True, text=True, check=False, timeout=7200,
+        )  # fmt: skip
+        if done.returncode != 0 or not output.is_file():
+            tail = (done.stderr.strip().splitlines() or ["no output"])[-1][:200]
+            raise RuntimeError(f"peer {peer} exited {done.returncode}: {tail}")
+        rows: list[dict[str, Any]] = json.loads(output.read_text(encoding="utf-8"))
+    return rows
+
+
+def compare_peers(problems: Sequence[Problem], results: Sequence[ProblemResult]) -> dict[str, Any]:
+    """Per robot and peer: solved, clean, median total, speed-up of lynxplan; for OMPL the
+    callback's share of the time and its calls. ``lines`` (to print) and ``misses`` (goals)."""
+    from lynxplan.bench.peers import peer_python
+
+    out: dict[str, Any] = {"lines": [], "misses": [], "figures": []}
+    by_name = {p.name: p for p in problems}
+    for robot in sorted({p.robot for p in problems}):
+        mine = [p for p in problems if p.robot == robot]
+        ours = [r.total_time for r in results if r.robot == robot and r.solved]
+        lynx_median = float(np.median(ours)) if ours else float("nan")
+        for peer in _SCRIPTS:
+            if not peer_python(peer).is_file():
+                out["lines"].append(f"peer {peer}: peer not installed ({peer_python(peer)})")
+                continue
+            try:
+                rows = _run(peer, _spec(mine))
+            except (RuntimeError, subprocess.TimeoutExpired) as error:
+                out["lines"].append(f"peer {peer} {robot}: could not run: {error}")
+                continue
+            out["figures"].append(_figures(peer, robot, rows, by_name, lynx_median, len(mine)))
+            out["lines"].append(_line(out["figures"][-1]))
+            figure = out["figures"][-1]
+            if peer == "ompl" and not figure["speedup"] >= GOAL_SPEEDUP:
+                out["misses"].append(f"{robot}: {figure['speedup']:.1f}x the OMPL median "
+                                     f"(goal >= {GOAL_SPEEDUP:g}x)")  # fmt: skip
+    return out
+
+
+def _figures(peer: str, robot: str, rows: list[dict[str, Any]], by_name: dict[str, Problem],
+             lynx_median: float, count: int) -> dict[str, Any]:  # fmt: skip
+    solved = [r for r in rows if r["solved"] and len(r["path"]) > 1]
+    arm = suite_robot(robot)
+    clean = sum(dense_check(arm, by_name[r["problem"]], np.array(r["path"])) > 0 for r in solved)
+    totals = [r["plan_time"] + r["simplify_time"] for r in solved]
+    median = float(np.median(totals)) if totals else float("nan")
+    figure = {"peer": peer, "robot": robot, "problems": count, "solved": len(solved),
+              "clean": int(clean), "median_total": median,
+              "speedup": median / lynx_median}  # fmt: skip
+    if peer == "ompl":
+        spent = sum(r["plan_time"] + r["simplify_time"] for r in rows)
+        figure["callback_share"] = sum(r["check_time"] for r in rows) / spent if spent else 0.0
+        figure["median_checks"] = float(np.median([r["checks"] for r in rows]))
+    return figure
+
+
+def _line(f: dict[str, Any]) -> str:
+    text = (f"peer {f['peer']:<10} {f['robot']:<6} solved {f['solved']}/{f['problems']}, clean "
+            f"{f['clean']}, median total {f['median_total'] * 1e3:.2f} ms; lynxplan "
+            f"{f['speedup']:.1f}x faster")  # fmt: skip
+    if "callback_share" in f:
+        text += (f"; Python validity callback {100 * f['callback_share']:.0f} % of OMPL's time, "
+                 f"median {f['median_checks']:.0f} checks/problem")  # fmt: skip
+    return text

@@ -1,0 +1,29 @@
+"""SmallArmBench on a Dask LocalCluster (2 workers): the same outcomes as the serial run."""
+
+from __future__ import annotations
+
+import pytest
+
+from lynxplan.benchsuite.distributed import chunks, run_on_dask
+from lynxplan.benchsuite.runner import run_serial
+from lynxplan.benchsuite.storage import load_shipped
+from lynxplan.exceptions import InputError
+
+
+def test_local_cluster_results_equal_serial() -> None:
+    problems = [p for p in load_shipped("al5") if p.index == 0][:4]
+    seen: list[tuple[int, int]] = []
+    distributed = run_on_dask(
+        problems, local_workers=2, chunk=1, progress=lambda d, n: seen.append((d, n))
+    )
+    serial = run_serial(problems)
+    assert [r.outcome() for r in distributed] == [r.outcome() for r in serial]
+    assert seen[-1] == (4, 4) and len(seen) == 4
+
+
+def test_chunks_and_bad_options() -> None:
+    assert [len(c) for c in chunks(list(range(10)), 4)] == [4, 4, 2]  # type: ignore[arg-type]
+    with pytest.raises(InputError, match="give one of --dask-scheduler ADDRESS and --dask-local"):
+        run_on_dask([])
+    with pytest.raises(InputError, match=r"--dask-local needs at least 1 worker\. Got: 0"):
+        run_on_dask([], local_workers=0)
