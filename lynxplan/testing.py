@@ -29,12 +29,12 @@ def assert_collision_free(
         t: Sample times, shape (N,), in [s].
         world: A :class:`lynxplan.collision.CollisionWorld`.
         clearance: Required distance at every sample, in [m] (0: no contact). Between samples
-            the check proves there is no contact (see :mod:`lynxplan.collision.check`).
+            the check proves there is no contact (see :mod:`lynxplan.collision.verify`).
         segment: Segment index of each sample, shape (N,), for the report's per-segment minima.
         acceleration_bound: Passed to :func:`lynxplan.collision.check_trajectory`.
 
     Returns:
-        The :class:`lynxplan.collision.CollisionReport`, for further checks.
+        The :class:`lynxplan.collision.MotionReport`, for further checks.
 
     Raises:
         AssertionError: a contact, an uncertified interval, or a clearance below the required.

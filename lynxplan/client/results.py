@@ -120,17 +120,9 @@ def ik_batch(fields: Mapping[str, Any]) -> Any:
 
 def collision_report(answer: Mapping[str, Any]) -> Any:
     """A :class:`~lynxplan.collision.CollisionReport` from a ``/check`` answer with times."""
-    from lynxplan.collision import CollisionReport, Contact
+    from lynxplan.collision import MotionReport
 
-    return CollisionReport(
-        min_clearance=_clearance(answer["min_clearance"]),
-        segments=tuple(_clearance(r) for r in answer["segments"]),
-        segment_ids=tuple(answer["segment_ids"]),
-        contacts=tuple(Contact(**c) for c in answer["contacts"]),
-        certified=answer["certified"],
-        refined_intervals=answer["refined_intervals"],
-        exact_queries=answer["exact_queries"],
-    )
+    return MotionReport.from_dict(answer)
 
 
 def profiles(answer: Mapping[str, Any]) -> list[Any]:
@@ -152,11 +144,9 @@ def profiles(answer: Mapping[str, Any]) -> list[Any]:
 
 def planned_trajectory(a: Mapping[str, Any]) -> Any:
     """A :class:`~lynxplan.planning.PlannedTrajectory` from a ``/plan`` answer."""
+    from lynxplan.collision import MotionReport
     from lynxplan.planning import PlannedTrajectory, PlannerOptions, PlanningStats
-    from lynxplan.planning.verify import VerificationReport
 
-    v = dict(a["verification"])
-    v["min_clearance"] = _clearance(v["min_clearance"])
     option_fields: dict[str, Any] = {
         k: tuple(x) if isinstance(x, list) else x for k, x in a["options"].items()
     }
@@ -167,7 +157,7 @@ def planned_trajectory(a: Mapping[str, Any]) -> Any:
         qd=_read_only(np.array(a["qd"], dtype=float)),
         qdd=_read_only(np.array(a["qdd"], dtype=float)),
         segment=_read_only(np.array(a["segment"], dtype=np.asarray(0).dtype)),
-        verification=VerificationReport(**v),
+        verification=MotionReport.from_dict(a["verification"]),
         goal_label=a["goal_label"],
         goal_index=a["goal_index"],
         path_length=a["path_length"],

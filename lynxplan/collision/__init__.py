@@ -1,13 +1,13 @@
-"""Collision checking with python-fcl: the arm's URDF collision geometry against obstacles."""
+"""Collision checking: the arm's URDF collision geometry against obstacles, and the exact verifier.
 
-from lynxplan.collision.check import (
-    MAX_BISECTION_DEPTH,
-    ClearanceRecord,
-    CollisionReport,
-    Contact,
-    check_trajectory,
-    clearance_profile,
-)
+- :mod:`~lynxplan.collision.world`: the arm's primitives and the obstacles, exact distances;
+- :mod:`~lynxplan.collision.verify`: the exact verifier (conservative advancement), the one
+  place that decides "collision free";
+- :mod:`~lynxplan.collision.report`: its one report type, :class:`MotionReport`;
+- :mod:`~lynxplan.collision.check`: sampled trajectories (task checks, the service's ``/check``).
+"""
+
+from lynxplan.collision.check import check_trajectory, clearance_profile
 from lynxplan.collision.obstacles import (
     BoxObstacle,
     CylinderObstacle,
@@ -16,6 +16,8 @@ from lynxplan.collision.obstacles import (
     axis_aligned_box,
     rotation_from_axis,
 )
+from lynxplan.collision.report import ClearanceRecord, CollisionReport, Contact, MotionReport
+from lynxplan.collision.verify import MAX_BISECTION_DEPTH
 from lynxplan.collision.world import CollisionWorld, LinkPrimitive
 
 __all__ = [
@@ -27,6 +29,7 @@ __all__ = [
     "Contact",
     "CylinderObstacle",
     "LinkPrimitive",
+    "MotionReport",
     "Obstacle",
     "SphereObstacle",
     "axis_aligned_box",

@@ -7,31 +7,14 @@ At the samples
     candidates in increasing order of their bound, exact queries until the next bound is no smaller
     than the best exact distance found. Every reported clearance is an exact (engine) distance.
 
-Between samples (conservative advancement)
-    Motion model: between samples k and k+1 every joint moves monotonically from ``q[k]`` to
-    ``q[k+1]`` (for instance linearly). Claim: if a pair's distances ``d0`` at ``t[k]`` and ``d1``
-    at ``t[k+1]`` satisfy ``d0 + d1 > D + 2 m``, with ``D = sum_j R_j |q[k+1, j] - q[k, j]|`` and
-    ``m`` the margin below, the pair does not touch anywhere in between; its clearance there is at
-    least ``(d0 + d1 - D) / 2 - m``.
-
-    Proof. Let ``R_j`` bound the distance of any point of the primitive from joint j's axis in any
-    configuration (chain of joint offsets plus the primitive's extent, see
-    :class:`LinkPrimitive`). Changing the joints one at a time, a rotation by ``dq_j`` about axis j
-    moves a point along an arc of length at most ``R_j |dq_j|``, so a material point p satisfies
-    ``|p(tau) - p(t_k)| <= a(tau) = sum_j R_j |q_j(tau) - q_j(t_k)|`` and likewise
-    ``|p(tau) - p(t_k+1)| <= b(tau)``; monotone joints give ``a + b = D``. The distance to a fixed
-    set is 1-Lipschitz, and every point of the primitive is at least ``d0`` (resp. ``d1``) from the
-    obstacle at the samples, so at time tau every point is at least
-    ``max(d0 - a, d1 - b) >= (d0 + d1 - (a + b)) / 2 = (d0 + d1 - D) / 2`` away. For a self pair
-    both primitives move and ``D`` is the sum of both bounds. If the real motion deviates from the
-    linear one by at most ``e_j = max|qdd_j| dt^2 / 8`` per joint (interpolation error of a C2
-    function), the same argument adds ``m = sum_j R_j e_j`` (``acceleration_bound``).
-
-    Intervals where the inequality fails (first with the lower bounds, then with exact distances)
-    are bisected on the linear interpolation: the midpoint is queried exactly, a distance <= 0 is
-    a contact between samples, otherwise both halves (each with half of D) are tested again. Each
-    bisection halves D, so the recursion ends unless the clearance is ~0 (grazing contact); after
-    :data:`MAX_BISECTION_DEPTH` levels the interval is reported as not certified.
+Between samples
+    The exact verifier (:mod:`lynxplan.collision.verify`, conservative advancement, proof there)
+    decides every sample interval: pairs whose sphere bounds at both samples already pass its
+    test need no exact query; the others are tested with exact distances and bisected where
+    those do not suffice. The motion bound of a pair on interval k is
+    ``D = sum_j R_j |q[k+1, j] - q[k, j]|`` (:meth:`CollisionWorld.motion_bounds`); an
+    ``acceleration_bound`` adds the interpolation-error margin
+    ``m = sum_j R_j max|qdd_j| dt^2 / 8``.
 
 Accuracy: with the default ``"coal"`` engine the clearances are exact to ~1e-10 m; the
 ``"fcl"`` engine (python-fcl) over-estimates box-box distances by up to millimetres (FCL issue
@@ -40,93 +23,20 @@ Accuracy: with the default ``"coal"`` engine the clearances are exact to ~1e-10 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-from typing import Any, NamedTuple
+from typing import Any
 
 import numpy as np
 
 from lynxplan import guards
+from lynxplan.collision.report import (
+    NO_RECORD,
+    ClearanceRecord,
+    Contact,
+    MotionReport,
+)
+from lynxplan.collision.verify import Certification, separated
 from lynxplan.collision.world import CollisionWorld, _configurations, reach_products
 from lynxplan.exceptions import LynxplanError, NonFiniteInputError, ShapeError, TrajectoryCheckError
-
-#: Bisection levels of one sample interval before it is reported as not certified.
-MAX_BISECTION_DEPTH = 40
-
-
-class ClearanceRecord(NamedTuple):
-    """The smallest distance between the arm and an obstacle over a set of times.
-
-    Attributes:
-        clearance: Exact distance (the world's engine), in [m]; ``inf`` when nothing was checked.
-        link: URDF link name of the closest primitive.
-        geometry: Name of the closest primitive, e.g. ``"gripper_1"`` (the pen).
-        obstacle: Name of the obstacle (``"self:<geometry>"`` for self-collision).
-        time: When it occurs, in [s].
-        sample: Sample index, or -1 for a time between samples (bisection).
-    """
-
-    clearance: float
-    link: str
-    geometry: str
-    obstacle: str
-    time: float
-    sample: int
-
-
-class Contact(NamedTuple):
-    """One contact: a pair in collision over a run of consecutive samples (or between samples).
-
-    Attributes:
-        link: URDF link name.
-        geometry: Primitive name.
-        obstacle: Obstacle name (``"self:<geometry>"`` for self-collision).
-        time: Time of the deepest penetration, in [s].
-        penetration_depth: Largest penetration depth (signed distance, negated), in [m].
-        t_start: First time the pair was found in contact, in [s].
-        t_end: Last time the pair was found in contact, in [s].
-        between_samples: Found by the between-sample check, not at a sample.
-    """
-
-    link: str
-    geometry: str
-    obstacle: str
-    time: float
-    penetration_depth: float
-    t_start: float
-    t_end: float
-    between_samples: bool
-
-
-@dataclass(frozen=True)
-class CollisionReport:
-    """Result of :func:`check_trajectory`.
-
-    Attributes:
-        min_clearance: Smallest clearance over the whole trajectory.
-        segments: Smallest clearance of each segment, in increasing segment index order.
-        segment_ids: The segment index of each entry of ``segments``.
-        contacts: Every contact, sorted by start time.
-        certified: Every sample interval passed the between-sample test (no interval left
-            undecided at :data:`MAX_BISECTION_DEPTH`).
-        refined_intervals: Number of (interval, pair) cases that needed bisection.
-        exact_queries: Number of exact distance queries made.
-    """
-
-    min_clearance: ClearanceRecord
-    segments: tuple[ClearanceRecord, ...]
-    segment_ids: tuple[int, ...]
-    contacts: tuple[Contact, ...]
-    certified: bool
-    refined_intervals: int
-    exact_queries: int
-
-    @property
-    def collision_free(self) -> bool:
-        """No contact at any sample nor between samples, and every interval certified."""
-        return not self.contacts and self.certified
-
-
-_NO_RECORD = ClearanceRecord(float("inf"), "", "", "", float("nan"), -1)
 
 
 class _Checker:
@@ -152,7 +62,7 @@ class _Checker:
     def segment_minimum(self, samples: np.ndarray) -> ClearanceRecord:
         """Branch and bound over the (sample, pair) candidates of one segment."""
         if self.world.pair_count == 0 or samples.size == 0:
-            return _NO_RECORD
+            return NO_RECORD
         bounds = self.bounds[samples]
         first = int(np.argmin(bounds))
         row, pair = divmod(first, self.world.pair_count)
@@ -202,36 +112,6 @@ class _Checker:
                 )
         return contacts
 
-    def distance_at(self, q: np.ndarray, pair: int) -> float:
-        self.queries += 1
-        return self.world.distance(self.world.primitive_poses(q)[0], pair)
-
-    def bisect(
-        self, k: int, pair: int, d0: float, d1: float, motion: float, margin: float
-    ) -> tuple[ClearanceRecord | None, Contact | None, bool]:
-        """Bisect interval k for one pair: (lowest midpoint clearance, contact, certified)."""
-        stack = [(0.0, 1.0, d0, d1, motion, 0)]
-        lowest: ClearanceRecord | None = None
-        q0, q1 = self.q[k], self.q[k + 1]
-        t0, dt = float(self.t[k]), float(self.t[k + 1] - self.t[k])
-        while stack:
-            s0, s1, a, b, span, depth = stack.pop()
-            if a + b > span + 2.0 * margin:
-                continue
-            if depth >= MAX_BISECTION_DEPTH:
-                return lowest, None, False
-            s = 0.5 * (s0 + s1)
-            distance = self.distance_at(q0 + s * (q1 - q0), pair)
-            time = t0 + s * dt
-            if lowest is None or distance < lowest.clearance:
-                lowest = self.record(distance, pair, time, -1)
-            if distance <= 0:
-                names = self.world.pair_names(pair)
-                return lowest, Contact(*names, time, -distance, time, time, True), True
-            stack.append((s0, s, a, distance, span / 2.0, depth + 1))
-            stack.append((s, s1, distance, b, span / 2.0, depth + 1))
-        return lowest, None, True
-
 
 def check_trajectory(
     world: CollisionWorld,
@@ -240,7 +120,7 @@ def check_trajectory(
     segment: Any = None,
     *,
     acceleration_bound: Any = None,
-) -> CollisionReport:
+) -> MotionReport:
     """Check a sampled joint trajectory against the world, at and between samples.
 
     Args:
@@ -267,37 +147,28 @@ def check_trajectory(
     contacts = checker.sample_contacts()
     ids = np.unique(segments)
     minima = {int(s): checker.segment_minimum(np.flatnonzero(segments == s)) for s in ids}
-    certified, refined = True, 0
+
+    def exact_at(k: int, s: float, pair: int) -> float:
+        q = config[k] + s * (config[k + 1] - config[k])
+        return world.distance(world.primitive_poses(q)[0], pair)
+
+    certification = Certification(world, times, exact_at)
+    certification.contacts = contacts
     if len(config) > 1 and world.pair_count:
         motion = world.motion_bounds(config)  # (N - 1, P)
         lower = np.maximum(checker.bounds, 0.0)
-        suspect = np.argwhere(lower[:-1] + lower[1:] <= motion + 2.0 * margins[:, None])
+        suspect = np.argwhere(~separated(lower[:-1], lower[1:], motion, margins[:, None]))
         for k, pair in suspect.tolist():
             d0, d1 = checker.exact(k, pair), checker.exact(k + 1, pair)
             if d0 <= 0 or d1 <= 0:
                 continue  # already a contact at a sample
-            if d0 + d1 > motion[k, pair] + 2.0 * margins[k]:
-                continue
-            refined += 1
-            lowest, contact, ok = checker.bisect(k, pair, d0, d1, motion[k, pair], margins[k])
-            certified &= ok
-            if contact is not None:
-                contacts.append(contact)
+            lowest = certification.bisect(
+                k, pair, (0.0, 1.0, d0, d1), float(motion[k, pair]), float(margins[k])
+            )
             owner = int(segments[k])
             if lowest is not None and lowest.clearance < minima[owner].clearance:
                 minima[owner] = lowest
-    ordered = tuple(minima[int(s)] for s in ids)
-    overall = min(ordered, key=lambda r: r.clearance) if ordered else _NO_RECORD
-    contacts.sort(key=lambda c: (c.t_start, c.geometry, c.obstacle))
-    return CollisionReport(
-        min_clearance=overall,
-        segments=ordered,
-        segment_ids=tuple(int(s) for s in ids),
-        contacts=tuple(contacts),
-        certified=certified,
-        refined_intervals=refined,
-        exact_queries=checker.queries,
-    )
+    return certification.report(0.0, minima, checker.queries + certification.queries)
 
 
 def clearance_profile(world: CollisionWorld, q: Any) -> np.ndarray:

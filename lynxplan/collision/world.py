@@ -282,7 +282,7 @@ class CollisionWorld:
 
         With joints moving monotonically from ``q[k]`` to ``q[k+1]`` (e.g. linearly), no point of
         primitive g moves farther than ``sum_j reach[g, j] * |q[k+1, j] - q[k, j]|`` from where it
-        was at either sample (see :mod:`lynxplan.collision.check`). For a self pair both
+        was at either sample (see :mod:`lynxplan.collision.verify`). For a self pair both
         primitives move, and the sum of both bounds applies.
 
         q: shape (N, nq), in [rad] -> shape (N - 1, P), in [m].

@@ -1,20 +1,16 @@
 """Exact verification of planned paths with coal, and the exact start/goal collision test.
 
 The planner's own checker is conservative but approximate (bounding boxes, separating axes). A
-returned path is therefore re-checked with exact coal distances between the URDF collision
-geometry and the obstacles, and between every pair of primitives on non-adjacent links, by
-conservative advancement on each straight joint segment, pair by pair: a pair is certified on
-``[s0, s1]`` when lower bounds ``d0``, ``d1`` of its distance at both ends exceed, together, the
-bound ``L (s1 - s0)`` on the motion of any of its points in between (``L``:
-:func:`lynxplan.planning.kernel_model.pair_rates`; proof in :mod:`lynxplan.collision.check`).
-The lower bounds are exact coal distances, except for a pair whose sphere gaps (one
-primitive's covering spheres against the other's box: :func:`lynxplan.planning.certify.sphere_gap`)
-already prove the whole segment. Where to query is
-chosen by :mod:`lynxplan.planning.certify` from the planner's tight bounds, so a clear path
-needs few exact queries (one per pair and waypoint near an obstacle, plus about ``L / 2d``
-along a segment that stays ``d`` from it); an interval that the exact distances do not prove
-is bisected with exact distances (a distance <= 0 is a contact). Nothing is sampled at a fixed
-resolution and nothing between checked configurations is left unproven.
+returned path is therefore certified by the exact verifier, :mod:`lynxplan.collision.verify`
+(the one module that decides "collision free", for task trajectories too): exact coal distances
+between the URDF collision geometry and the obstacles, and between every pair of primitives on
+non-adjacent links, proven between the queries by its conservative advancement on each straight
+joint segment, pair by pair, and bisected with exact distances where they do not suffice (a
+distance <= 0 is a contact). This module only chooses *where* to query: the schedule of
+:mod:`lynxplan.planning.certify` from the planner's tight bounds, so a clear path needs few
+exact queries (one per pair and waypoint near an obstacle, plus about ``L / 2d`` along a segment
+that stays ``d`` from it; ``L``: :func:`lynxplan.planning.kernel_model.pair_rates`). Nothing is
+sampled at a fixed resolution and nothing between checked configurations is left unproven.
 
 Self-collision pairs ("allowed pairs" from the URDF adjacency): two primitives are *not*
 checked when they hang on the same joint or on a parent/child pair of joints (they touch by
@@ -31,17 +27,17 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
-from dataclasses import dataclass
 from typing import NamedTuple
 
 import numpy as np
 
 from lynxplan._arrays import kernel_input
-from lynxplan.collision import ClearanceRecord, CollisionWorld
+from lynxplan.collision import CollisionWorld
+from lynxplan.collision.report import Contact, MotionReport, VerificationReport
+from lynxplan.collision.verify import Certification
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
 from lynxplan.planning.certify import (
     configuration_poses,
-    row_distances,
     row_transforms,
     segment_rates,
     verification_rows,
@@ -49,37 +45,8 @@ from lynxplan.planning.certify import (
 )
 from lynxplan.planning.kernel_model import kernel_model, make_scratch, world_pairs
 
-#: Bisection levels of one interval before it is reported as not certified (grazing contact).
-MAX_BISECTION_DEPTH = 40
 #: First capacity of the schedule's rows (grown while too small).
 _ROWS = 1024
-
-
-@dataclass(frozen=True)
-class VerificationReport:
-    """Exact verification of a path.
-
-    Attributes:
-        collision_free: No contact anywhere along the path, every interval certified.
-        min_clearance: Smallest exact distance found at the waypoints and at the configurations
-            the certification queried (link, obstacle, where), in [m]; its ``time`` is the path
-            parameter (waypoint index, fractional between waypoints). In between, the path is
-            certified collision-free, and the planner's own certificate guarantees at least
-            ``required_clearance`` everywhere.
-        required_clearance: The planner's required clearance, in [m].
-        self_collision_pairs: Number of self-collision pairs checked.
-        obstacle_pairs: Number of primitive/obstacle pairs checked.
-        exact_queries: Exact (coal) distance queries made.
-        refined_intervals: (interval, pair) cases certified by bisection.
-    """
-
-    collision_free: bool
-    min_clearance: ClearanceRecord
-    required_clearance: float
-    self_collision_pairs: int
-    obstacle_pairs: int
-    exact_queries: int
-    refined_intervals: int
 
 
 class _Schedule(NamedTuple):
@@ -249,152 +216,84 @@ class ExactVerifier:
                 )
             self._buffers = _row_buffers(4 * len(columns[0]))
 
-    def verify(self, waypoints: np.ndarray, clearance: float) -> VerificationReport:
+    def verify(self, waypoints: np.ndarray, clearance: float) -> MotionReport:
         """Certify a piecewise-linear path (N, nq), in [rad]; see :func:`verify_path`."""
         path = kernel_input(np.asarray(waypoints, dtype=float))
         if len(path) == 1:
             path = np.vstack([path, path])
         self.queries = 0
-        check = _PathCheck(self, path)
-        check.run()
-        if check.contact is not None:
-            raise PathVerificationError(check.contact)
-        if not check.certified:
+        certification = self.certify(path)
+        if certification.contacts:
+            raise PathVerificationError(_describe(certification.contacts[0]))
+        if not certification.certified:
             raise PathVerificationError("an interval could not be certified (grazing contact)")
-        self_pairs = self._self_pairs
-        return VerificationReport(
-            collision_free=True,
-            min_clearance=check.minimum(),
-            required_clearance=clearance,
-            self_collision_pairs=self_pairs,
-            obstacle_pairs=self.world.pair_count - self_pairs,
-            exact_queries=self.queries,
-            refined_intervals=check.refined,
-        )
+        return certification.report(clearance, queries=self.queries)
 
+    def certify(self, path: np.ndarray) -> Certification:
+        """The exact verifier's certification of path (M, nq) [rad] (time: the path parameter,
+        the waypoint index), fed with the scheduled exact distances; it stops at the first
+        contact."""
+        rates: list[np.ndarray] = []  # the static motion bounds, for bisection only
 
-class _PathCheck:
-    """One path's certification: exact distances by path parameter, bisection, the minimum.
+        def exact_at(k: int, s: float, pair: int) -> float:
+            return self.exact(self.poses(path, np.array([k]), np.array([s]))[0], pair)
 
-    The scheduled rows' distances stay in arrays (where: path parameter, pair, distance); the
-    few distances queried after them (waypoint minimum, bisection) go to a dict keyed by
-    (path parameter, pair), which also looks the rows up once one of those is needed."""
+        certification = Certification(self.world, np.arange(len(path), dtype=float), exact_at)
+        planned = self.schedule(path)
+        exact = self.exact_posed(planned.query_pair, planned.rotation, planned.translation)
+        # a row at an earlier row's configuration has its distance
+        distance = exact[planned.lookup]
+        segment, parameter, pair = planned.segment, planned.parameter, planned.pair
+        certification.add_rows(segment, parameter, pair, distance)
+        if certification.first_row_contact():
+            return certification
+        self._waypoint_minimum(certification, planned, distance)
+        if certification.contacts:
+            return certification
+        for r in certification.failed_rows(planned.motion).tolist():
+            if not rates:
+                rates.append(segment_rates(path, self.model))
+            k, p, s0, s1 = int(segment[r]), int(pair[r]), parameter[r], parameter[r + 1]
+            ends = (float(s0), float(s1), float(distance[r]), float(distance[r + 1]))
+            certification.bisect(k, p, ends, float(rates[0][k, p]) * (s1 - s0))
+            if certification.contacts or not certification.certified:
+                break
+        return certification
 
-    def __init__(self, verifier: ExactVerifier, path: np.ndarray) -> None:
-        self.verifier, self.path = verifier, path
-        self._rates: np.ndarray | None = None  # (M - 1, P), for bisection only
-        self.where = np.empty(0)
-        self.pair = np.empty(0, dtype=np.int64)
-        self.distance = np.empty(0)
-        self._known: dict[tuple[float, int], float] | None = None
-        self.extra: dict[tuple[float, int], float] = {}
-        self.contact: str | None = None
-        self.certified = True
-        self.refined = 0
-
-    @property
-    def rates(self) -> np.ndarray:
-        """Static motion bound of every pair per unit s on every segment, (M - 1, P), in [m]."""
-        if self._rates is None:
-            self._rates = segment_rates(self.path, self.verifier.model)
-        return self._rates
-
-    @property
-    def known(self) -> dict[tuple[float, int], float]:
-        """Every exact distance so far by (path parameter, pair), in [m] (the rows' built on
-        first use)."""
-        if self._known is None:
-            keys = zip(self.where.tolist(), self.pair.tolist(), strict=True)
-            self._known = dict(zip(keys, self.distance.tolist(), strict=True))
-        return self._known
-
-    def distance_at(self, poses: np.ndarray, where: float, pair: int) -> float:
-        """The exact distance of pair at path parameter where (primitive poses (G, 4, 4) there),
-        queried once."""
-        key = (where, pair)
-        known = self.known.get(key)
-        if known is None:
-            known = self.known[key] = self.extra[key] = self.verifier.exact(poses, pair)
-            if known <= 0.0:
-                self._report_contact(where, pair, known)
-        return known
-
-    def _report_contact(self, where: float, pair: int, distance: float) -> None:
-        """Record the first contact found (distance <= 0, in [m]) at path parameter where."""
-        if self.contact is None:
-            link, geometry, other = self.verifier.world.pair_names(pair)
-            self.contact = (
-                f"{link} ({geometry}) touches {other} at path parameter {where:.4f}, "
-                f"penetration {-distance * 1e3:.4f} mm"
-            )
-
-    def run(self) -> None:
-        verifier, path = self.verifier, self.path
-        planned = verifier.schedule(path)
-        segment, parameter, pair, motion = planned[:4]
-        exact = verifier.exact_posed(planned.query_pair, planned.rotation, planned.translation)
-        # a row at an earlier row's configuration has its distance; the chains' failed tests
-        distance, where, contact, fails = row_distances(
-            exact, planned.lookup, segment, parameter, motion
-        )
-        self.where, self.pair, self.distance = where, pair, distance
-        if contact >= 0:
-            r = contact
-            self._report_contact(float(where[r]), int(pair[r]), float(distance[r]))
-            return
-        self._waypoint_minimum(planned.bounds, planned.poses)
-        if self.contact is not None:
-            return
-        for r in fails.tolist():
-            self.bisect(int(segment[r]), int(pair[r]), float(parameter[r]), float(parameter[r + 1]))
-            if self.contact is not None or not self.certified:
-                return
-
-    def bisect(self, k: int, pair: int, s0: float, s1: float) -> None:
-        """Certify pair on [s0, s1] of segment k by bisection with exact distances."""
-        self.refined += 1
-        rate = float(self.rates[k, pair])
-        stack = [(s0, s1, self.known[(k + s0, pair)], self.known[(k + s1, pair)], 0)]
-        while stack:
-            a, b, da, db, depth = stack.pop()
-            if da + db > rate * (b - a):
-                continue
-            if depth >= MAX_BISECTION_DEPTH:
-                self.certified = False
-                return
-            s = 0.5 * (a + b)
-            poses = self.verifier.poses(self.path, np.array([k]), np.array([s]))[0]
-            d = self.distance_at(poses, k + s, pair)
-            if d <= 0.0:
-                return
-            stack += [(a, s, da, d, depth + 1), (s, b, d, db, depth + 1)]
-
-    def _waypoint_minimum(self, bounds: np.ndarray, poses: np.ndarray) -> None:
+    def _waypoint_minimum(
+        self, certification: Certification, planned: _Schedule, distance: np.ndarray
+    ) -> None:
         """Exact smallest distance over the waypoints, branch and bound on the planner's
-        bounds (N, P), in [m] (every pair whose bound is below the best exact distance is
-        queried, at the primitive poses (N, G, 4, 4) of its waypoint)."""
+        bounds (N, P), in [m]: every pair whose bound is below the best exact distance is
+        queried (unless a row has it), at the primitive poses of its waypoint; a contact stops."""
+        bounds = planned.bounds
         pairs = bounds.shape[1]
-        best = float(self.distance.min()) if self.distance.size else np.inf
+        best = float(distance.min()) if distance.size else np.inf
         if not pairs or bounds.min() >= best:
             return
+        where = (planned.segment + planned.parameter).tolist()
+        known = set(zip(where, planned.pair.tolist(), strict=True))
         flat_bounds = bounds.ravel().tolist()
         for flat in np.argsort(bounds, axis=None).tolist():
             if flat_bounds[flat] >= best:
                 break
             n, pair = divmod(flat, pairs)
-            best = min(best, self.distance_at(poses[n], float(n), pair))
+            if (float(n), pair) in known:
+                continue  # a row's distance: not below the rows' minimum
+            d = self.exact(planned.poses[n], pair)
+            certification.probe(n, 0.0, pair, d)
+            if d <= 0.0:
+                certification.contacts.append(certification.contact_at(d, n, 0.0, pair, False))
+                return
+            best = min(best, d)
 
-    def minimum(self) -> ClearanceRecord:
-        candidates = [(value, key) for key, value in self.extra.items()]
-        if self.distance.size:
-            r = int(np.argmin(self.distance))
-            candidates.append((float(self.distance[r]), (float(self.where[r]), int(self.pair[r]))))
-        if not candidates:
-            return ClearanceRecord(float("inf"), "", "", "", float("nan"), -1)
-        clearance, (where, pair) = min(candidates)
-        link, geometry, other = self.verifier.world.pair_names(pair)
-        sample = int(where) if where == int(where) else -1
-        return ClearanceRecord(clearance, link, geometry, other, where, sample)
+
+def _describe(contact: Contact) -> str:
+    """A path's contact, for :class:`PathVerificationError`."""
+    return (
+        f"{contact.link} ({contact.geometry}) touches {contact.obstacle} at path parameter "
+        f"{contact.time:.4f}, penetration {contact.penetration_depth * 1e3:.4f} mm"
+    )
 
 
 _VERIFIERS: weakref.WeakKeyDictionary[CollisionWorld, ExactVerifier] = weakref.WeakKeyDictionary()
@@ -408,15 +307,17 @@ def verifier_of(world: CollisionWorld) -> ExactVerifier:
     return verifier
 
 
-def verify_path(
-    world: CollisionWorld, waypoints: np.ndarray, clearance: float
-) -> VerificationReport:
+def verify_path(world: CollisionWorld, waypoints: np.ndarray, clearance: float) -> MotionReport:
     """Verify a piecewise-linear joint path exactly.
 
     Args:
         world: Collision world built with ``self_collision=True``.
         waypoints: Shape (N, nq), in [rad]; the path is the straight joint segments between them.
         clearance: The required clearance the planner guaranteed, in [m] (reported).
+
+    Returns:
+        The exact verifier's report (:class:`lynxplan.collision.MotionReport`); its
+        ``min_clearance.time`` is the path parameter (waypoint index, fractional between).
 
     Raises:
         PathVerificationError: a contact or an uncertified interval (never expected: the
@@ -468,3 +369,15 @@ def sample_clearances(world: CollisionWorld, q: np.ndarray) -> np.ndarray:
     """
     distances: np.ndarray = verifier_of(world).closest(np.asarray(q, dtype=float))[0]
     return distances
+
+
+__all__ = [
+    "ExactVerifier",
+    "VerificationReport",
+    "clear_states",
+    "closest_contact",
+    "require_clear",
+    "sample_clearances",
+    "verifier_of",
+    "verify_path",
+]

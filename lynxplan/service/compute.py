@@ -136,17 +136,8 @@ def check_arrays(
             obstacles=[o.name for o in obstacles],
         )
         return out
-    report = check_trajectory(world, configs, t)
-    out.update(
-        collision_free=report.collision_free,
-        certified=report.certified,
-        min_clearance=report.min_clearance._asdict(),
-        segments=[record._asdict() for record in report.segments],
-        segment_ids=list(report.segment_ids),
-        contacts=[c._asdict() for c in report.contacts],
-        refined_intervals=report.refined_intervals,
-        exact_queries=report.exact_queries,
-    )
+    # the exact verifier's report (lynxplan.collision.MotionReport), every field
+    out.update(check_trajectory(world, configs, t).as_dict())
     return out
 
 
@@ -235,10 +226,8 @@ def plan_json(
     result = plan(arm, obstacles, start, goal, seed=seed, time_limit=time_limit,
                   options=PlannerOptions(**options))  # fmt: skip
     fields = {f.name: getattr(result, f.name) for f in dataclasses.fields(result)}
-    verification = dataclasses.asdict(result.verification)
-    verification["min_clearance"] = result.verification.min_clearance._asdict()
     fields.update(
-        verification=verification,
+        verification=result.verification.as_dict(),
         stats=dataclasses.asdict(result.stats),
         options=dataclasses.asdict(result.options),
         duration=result.duration,

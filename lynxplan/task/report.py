@@ -25,7 +25,7 @@ ACCURACY_STATEMENT = (
     f"agrees with coal to {FCL_DISTANCE_TOLERANCE:g} m on most queries but over-estimates some "
     "by millimetres (FCL issue #508), so it is not used for reported figures. Between samples a "
     "conservative-advancement bound (link reach times joint motion, plus the interpolation margin "
-    "from the peak joint accelerations; proof in lynxplan.collision.check) certifies every sample "
+    "from the peak joint accelerations; proof in lynxplan.collision.verify) certifies every sample "
     "interval or bisects it until it does or finds a contact."
 )
 

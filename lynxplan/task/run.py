@@ -63,7 +63,7 @@ class TaskResult:
         samples: The plan sampled at the scenario's rate (``lynxplan.trajectory.PlanSamples``).
         segments: Per-segment figures from the samples (``SegmentReport``).
         limits: Per-segment joint-limit checks.
-        collision: The collision report (``lynxplan.collision.CollisionReport``).
+        collision: The collision report (``lynxplan.collision.MotionReport``).
         world: The collision world (arm primitives + obstacles).
         comparison: The ruckig/toppra comparison (``PlanComparison``), or None.
         stage_seconds: Wall time of each stage, in [s].
