@@ -5,12 +5,13 @@ The exact verifier (:mod:`lynxplan.planning.verify`) certifies each straight joi
 bound per unit ``s`` (:func:`lynxplan.planning.kernel_model.pair_rates`: no point of the pair's
 geometry moves, relative to the other side, more than ``L |s1 - s0|`` between ``s0`` and
 ``s1``), lower bounds ``d0``, ``d1`` of the pair's distance at ``s0`` and ``s1`` prove it apart
-on the whole interval when ``d0 + d1 > L (s1 - s0)`` (proof in :mod:`lynxplan.collision.check`:
+on the whole interval when ``d0 + d1 > L (s1 - s0)`` (proof in :mod:`lynxplan.collision.verify`:
 at any ``s`` in between every point is at least ``max(d0 - a, d1 - b)`` away with ``a + b = L
 (s1 - s0)``).
 
 This module only *chooses* the parameters ``s`` at which the verifier asks coal for exact
-distances; it proves nothing itself:
+distances; it proves nothing itself (the exact verifier, :mod:`lynxplan.collision.verify`,
+decides):
 
 - a pair whose sphere gaps prove it apart on the segment needs no exact query there (the
   point distance of one primitive's covering spheres, a few along its longest axis, from the
@@ -523,37 +524,3 @@ def verification_rows(
         path, segment[which], parameter[which], pair[which], model, scratch, rotation, translation
     )
     return count, queries
-
-
-@njit_refcounted()
-def row_distances(
-    exact: np.ndarray,
-    lookup: np.ndarray,
-    segment: np.ndarray,
-    parameter: np.ndarray,
-    motion: np.ndarray,
-) -> tuple[np.ndarray, np.ndarray, int, np.ndarray]:
-    """The scheduled rows' exact distances and what they prove, in one call.
-
-    exact: (Q,) the queries' distances, in [m]; lookup, segment, parameter, motion: (R,) the
-    rows' columns (:func:`verification_rows`). Returns each row's distance (R,) (its query's),
-    its path parameter (R,) (segment + s), the first row whose distance is <= 0 (a contact; -1
-    when none), and the rows r (increasing) whose interval to the next row of their chain the
-    exact distances do not prove: ``motion[r] >= 0`` and ``d_r + d_{r+1} <= motion[r]``.
-    """
-    rows = lookup.shape[0]
-    distance = np.empty(rows)
-    where = np.empty(rows)
-    contact = -1
-    for r in range(rows):
-        distance[r] = exact[lookup[r]]
-        where[r] = segment[r] + parameter[r]
-        if contact < 0 and distance[r] <= 0.0:
-            contact = r
-    fails = np.empty(max(rows - 1, 0), dtype=np.int64)
-    count = 0
-    for r in range(rows - 1):
-        if motion[r] >= 0.0 and distance[r] + distance[r + 1] <= motion[r]:
-            fails[count] = r
-            count += 1
-    return distance, where, contact, fails[:count]
