@@ -34,7 +34,7 @@ from lynxplan.collision.report import (
     Contact,
     MotionReport,
 )
-from lynxplan.collision.verify import Certification, separated
+from lynxplan.collision.verify import Certification, separated, smallest_exact
 from lynxplan.collision.world import CollisionWorld, _configurations, reach_products
 from lynxplan.exceptions import LynxplanError, NonFiniteInputError, ShapeError, TrajectoryCheckError
 
@@ -63,25 +63,16 @@ class _Checker:
         """Branch and bound over the (sample, pair) candidates of one segment."""
         if self.world.pair_count == 0 or samples.size == 0:
             return NO_RECORD
-        bounds = self.bounds[samples]
-        first = int(np.argmin(bounds))
-        row, pair = divmod(first, self.world.pair_count)
-        best, best_key = self.exact(int(samples[row]), pair), (int(samples[row]), pair)
-        # Only candidates whose bound is below the best distance can beat it; bounds <= 0 prove
-        # nothing (not even about penetration depth), so those are always queried.
-        candidates = np.flatnonzero((bounds < best) | (bounds <= 0))
-        flat = bounds.ravel()[candidates]
-        order = np.argsort(flat)
-        # Plain Python numbers in the loop: it runs thousands of times in a 1 kHz trajectory.
-        sample_of_row, pairs = samples.tolist(), self.world.pair_count
-        for bound, candidate in zip(flat[order].tolist(), candidates[order].tolist(), strict=True):
-            if bound >= best and bound > 0:
-                break
+        pairs = self.world.pair_count
+        sample_of_row = samples.tolist()
+
+        def exact(candidate: int) -> float:
             row, pair = divmod(candidate, pairs)
-            distance = self.exact(sample_of_row[row], pair)
-            if distance < best:
-                best, best_key = distance, (sample_of_row[row], pair)
-        sample, pair = best_key
+            return self.exact(sample_of_row[row], pair)
+
+        best, candidate = smallest_exact(self.bounds[samples].ravel(), exact)
+        row, pair = divmod(candidate, pairs)
+        sample = sample_of_row[row]
         return self.record(best, pair, float(self.t[sample]), sample)
 
     def sample_contacts(self) -> list[Contact]:

@@ -63,6 +63,37 @@ def separated(d0: Any, d1: Any, motion: Any, margin: Any = 0.0) -> Any:
     return d0 + d1 > motion + 2.0 * margin
 
 
+def smallest_exact(
+    bounds: np.ndarray, exact: Callable[[int], float], best: float = np.inf
+) -> tuple[float, int]:
+    """Branch and bound: the smallest exact distance among candidates with lower bounds.
+
+    bounds: lower bounds of the candidates' distances, shape (M,), in [m] (a bound <= 0 proves
+    nothing, not even about penetration depth: such a candidate is always queried); exact(i):
+    candidate i's exact distance, in [m]; best: a distance already known, in [m] (only
+    candidates below it are looked at). Candidates are queried in increasing order of their
+    bound until a positive bound reaches the best distance found. Returns the smallest distance
+    and its candidate (``best`` and -1 when no candidate is below it).
+    """
+    first = index = -1
+    if bounds.size and best == np.inf:
+        first = index = int(np.argmin(bounds))
+        best = exact(first)
+    candidates = np.flatnonzero((bounds < best) | (bounds <= 0.0))
+    flat = bounds[candidates]
+    order = np.argsort(flat, kind="stable")
+    # Plain Python numbers in the loop: it runs thousands of times in a 1 kHz trajectory.
+    for bound, i in zip(flat[order].tolist(), candidates[order].tolist(), strict=True):
+        if bound > 0.0 and bound >= best:
+            break
+        if i == first:
+            continue
+        distance = exact(i)
+        if distance < best:
+            best, index = distance, i
+    return best, index
+
+
 class Certification:
     """One motion's exact certification: exact distances where they were queried, the contacts,
     the intervals proven, and the report.
@@ -238,4 +269,10 @@ class Certification:
         )
 
 
-__all__ = ["MAX_BISECTION_DEPTH", "Certification", "ExactDistance", "separated"]
+__all__ = [
+    "MAX_BISECTION_DEPTH",
+    "Certification",
+    "ExactDistance",
+    "separated",
+    "smallest_exact",
+]

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Sequence
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -34,7 +35,7 @@ import numpy as np
 from lynxplan._arrays import kernel_input
 from lynxplan.collision import CollisionWorld
 from lynxplan.collision.report import Contact, MotionReport, VerificationReport
-from lynxplan.collision.verify import Certification
+from lynxplan.collision.verify import Certification, smallest_exact
 from lynxplan.exceptions import PathVerificationError, StateInCollisionError
 from lynxplan.planning.certify import (
     configuration_poses,
@@ -177,15 +178,8 @@ class ExactVerifier:
         distances = np.full(len(config), np.inf)
         pairs = np.full(len(config), -1, dtype=np.int64)
         for n in range(len(config)):
-            best, best_pair = np.inf, -1
-            lower = bounds[n].tolist()
-            for pair in np.argsort(bounds[n], kind="stable").tolist():
-                if lower[pair] > 0.0 and lower[pair] >= best:
-                    break
-                distance = self.exact(poses[n], pair)
-                if distance < best:
-                    best, best_pair = distance, pair
-            distances[n], pairs[n] = best, best_pair
+            exact = partial(self.exact, poses[n])
+            distances[n], pairs[n] = smallest_exact(bounds[n], exact)
         return distances, pairs
 
     def schedule(self, path: np.ndarray) -> _Schedule:
@@ -263,29 +257,24 @@ class ExactVerifier:
     def _waypoint_minimum(
         self, certification: Certification, planned: _Schedule, distance: np.ndarray
     ) -> None:
-        """Exact smallest distance over the waypoints, branch and bound on the planner's
-        bounds (N, P), in [m]: every pair whose bound is below the best exact distance is
-        queried (unless a row has it), at the primitive poses of its waypoint; a contact stops."""
-        bounds = planned.bounds
-        pairs = bounds.shape[1]
-        best = float(distance.min()) if distance.size else np.inf
-        if not pairs or bounds.min() >= best:
-            return
+        """Exact smallest distance over the waypoints (:func:`smallest_exact` on the planner's
+        bounds (N, P), in [m], below the rows' smallest distance; a pair a row has at a
+        waypoint is not queried again), at the primitive poses of its waypoint."""
+        pairs = planned.bounds.shape[1]
         where = (planned.segment + planned.parameter).tolist()
         known = set(zip(where, planned.pair.tolist(), strict=True))
-        flat_bounds = bounds.ravel().tolist()
-        for flat in np.argsort(bounds, axis=None).tolist():
-            if flat_bounds[flat] >= best:
-                break
+
+        def exact(flat: int) -> float:
             n, pair = divmod(flat, pairs)
             if (float(n), pair) in known:
-                continue  # a row's distance: not below the rows' minimum
+                return np.inf  # a row's distance: not below the rows' minimum
             d = self.exact(planned.poses[n], pair)
             certification.probe(n, 0.0, pair, d)
-            if d <= 0.0:
+            if d <= 0.0 and not certification.contacts:
                 certification.contacts.append(certification.contact_at(d, n, 0.0, pair, False))
-                return
-            best = min(best, d)
+            return d
+
+        smallest_exact(planned.bounds.ravel(), exact, float(distance.min(initial=np.inf)))
 
 
 def _describe(contact: Contact) -> str:

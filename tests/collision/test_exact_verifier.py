@@ -15,7 +15,7 @@ from lynxplan.collision import (
     SphereObstacle,
     check_trajectory,
 )
-from lynxplan.collision.verify import Certification, separated
+from lynxplan.collision.verify import Certification, separated, smallest_exact
 from lynxplan.constants import COAL_GJK_TOLERANCE
 from lynxplan.exceptions import PathVerificationError
 from lynxplan.planning import VerificationReport
@@ -129,3 +129,33 @@ def test_bisection_matches_a_dense_exact_check(arm: Arm, hit: bool) -> None:
     if not hit:
         assert lowest.clearance >= min(dense) - COAL_GJK_TOLERANCE
         assert lowest.clearance == pytest.approx(exact_at(0, lowest.time, pair), abs=1e-12)
+
+
+def test_branch_and_bound_finds_the_smallest_exact_distance(arm: Arm) -> None:
+    """smallest_exact on the world's sphere bounds gives the smallest distance of all pairs
+    (and its pair), in contact and apart, querying fewer pairs than there are."""
+    world = CollisionWorld(
+        arm,
+        [BoxObstacle("post", [0.12, 0.18, 0.05], [0.04, 0.04, 0.3])],
+        self_collision=True,
+    )
+    rng = np.random.default_rng(3)
+    lower, upper = np.asarray(arm.limits.lower), np.asarray(arm.limits.upper)
+    q = rng.uniform(lower, upper, size=(30, lower.size))
+    poses, every = world.primitive_poses(q), world.distances(q)
+    bounds = world.lower_bounds(poses)
+    queried = 0
+    for n in range(len(q)):
+        asked: list[int] = []
+
+        def exact(pair: int, n: int = n, asked: list[int] = asked) -> float:
+            asked.append(pair)
+            return world.distance(poses[n], pair)
+
+        best, pair = smallest_exact(bounds[n], exact)
+        assert best == pytest.approx(every[n].min(), abs=COAL_GJK_TOLERANCE)
+        assert every[n, pair] == pytest.approx(best, abs=COAL_GJK_TOLERANCE)
+        queried += len(asked)
+    assert (every.min(axis=1) < 0).any() and (every.min(axis=1) > 0).any()
+    assert queried < every.size / 2
+    assert smallest_exact(np.empty(0), lambda pair: 0.0) == (np.inf, -1)
