@@ -38,6 +38,8 @@ class BuiltinRobot:
         tool: Name of its tool frame.
         package_dirs: Folders that ``package://`` mesh URIs resolve against.
         arm_joints: Joints of its arm chain (the gripper's locked joints not counted).
+        srdf: Its SRDF (the self-collision pairs it disables) where :func:`find_srdf` would not
+            find it by the URDF's name; None: found by name, or none.
     """
 
     name: str
@@ -46,6 +48,7 @@ class BuiltinRobot:
     tool: str
     package_dirs: tuple[str, ...]
     arm_joints: int = 5
+    srdf: Path | None = None
 
 
 def _example_robot_data_dir() -> Path:
@@ -94,6 +97,7 @@ def builtin_robots() -> dict[str, BuiltinRobot]:
             "tool0",
             packages,
             6,
+            robots / "ur_description" / "srdf" / "ur5.srdf",
         ),
         "ur10": BuiltinRobot(
             "ur10",
@@ -270,7 +274,7 @@ def load_model(  # noqa: PLR0912, PLR0915 (URDF reading steps in order)
     for folder in dirs:
         if not Path(folder).is_dir():
             raise ModelError(f"package_dirs: {folder} is not a folder")
-    srdf_path = _srdf_of(urdf, srdf)
+    srdf_path = _srdf_of(urdf, srdf if srdf is not None or spec is None else spec.srdf)
     disabled = read_disabled_collisions(srdf_path) if srdf_path is not None else ()
     try:
         xml = urdf.read_text()

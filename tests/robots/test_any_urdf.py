@@ -326,3 +326,20 @@ def test_the_srdf_next_to_the_urdf_names_the_pairs_not_checked(tmp_path: Path) -
         load_robot(_erd("panda_description/urdf/panda.urdf"), srdf="nowhere.srdf")
     with pytest.raises(ModelError, match=r"package_dirs: .* is not a folder"):
         load_robot("so101", package_dirs=[str(tmp_path / "nowhere")])
+
+
+def test_builtin_arms_of_example_robot_data_carry_their_srdf_and_plan() -> None:
+    """``load_robot("ur5")`` reads example-robot-data's ``srdf/ur5.srdf`` (named unlike its URDF,
+    ``ur5_robot.urdf``): without its disabled pairs the planner's conservative checker cannot
+    certify a UR5 start at all."""
+    import lynxplan
+
+    ur5 = load_robot("ur5")
+    assert ("shoulder_link", "upper_arm_link") in {
+        tuple(sorted(p)) for p in ur5.disabled_collisions
+    }
+    start, goal = np.radians(ARMS[0][2]), np.radians(ARMS[0][3])
+    motion = lynxplan.plan(ur5, [], start, goal, seed=0)
+    assert motion.verification.collision_free
+    np.testing.assert_allclose(motion.q[-1], goal, atol=1e-9)
+    assert len(load_robot("panda").disabled_collisions) > 0
