@@ -103,8 +103,11 @@ def handle(args: argparse.Namespace) -> int:
             f"binding to {args.host} requires --token-file (only loopback may "
             "serve without a token)"
         )
-    if args.workers < 1 or args.compute_workers < 1 or not 0 < args.port < 65536:
-        raise InputError("--workers and --compute-workers must be >= 1 and --port within 1..65535")
+    for option, value in (("--workers", args.workers), ("--compute-workers", args.compute_workers)):
+        if value < 1:
+            raise InputError(f"{option} must be >= 1. Got: {value}")
+    if not 0 < args.port < 65536:
+        raise InputError(f"--port must be within 1..65535. Got: {args.port}")
     if args.max_connections < 1:
         raise InputError(f"--max-connections must be >= 1. Got: {args.max_connections}")
     for option, value in (
