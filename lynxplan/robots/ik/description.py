@@ -7,6 +7,7 @@ the Robot builds it once from its URDF and hands it to :mod:`lynxplan.robots.ik.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Any
 
 import numpy as np
@@ -39,9 +40,9 @@ class Kinematics:
         """Number of joints."""
         return int(self.lower.shape[0])
 
-    @property
+    @cached_property
     def solver_name(self) -> str:
-        """Name of the IK solver of this arm (``Robot.ik_solver``)."""
+        """Name of the IK solver of this arm (``Robot.ik_solver``; each result carries it)."""
         if self.family is None:
             return "numerical (Levenberg-Marquardt, multi-start)"
         name = "yaw-pitch3-roll closed form"

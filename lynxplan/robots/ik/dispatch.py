@@ -14,6 +14,8 @@ The solver modules load their numba kernels, so they are imported on first use.
 
 from __future__ import annotations
 
+import functools
+from types import ModuleType
 from typing import Any
 
 import numpy as np
@@ -23,15 +25,30 @@ from lynxplan.robots.results import RobotIkBatch, RobotIkResult
 from lynxplan.robots.targets import Target
 
 
+@functools.cache
+def _solver(name: str) -> ModuleType:
+    """A solver module, imported on first use (it loads the numba kernels); cached, so a
+    single-pose call pays no import statement."""
+    if name == "numerical_solver":
+        from lynxplan.robots.ik import numerical_solver
+
+        return numerical_solver
+    from lynxplan.robots.ik import family_solver
+
+    return family_solver
+
+
 def solve(kinematics: Kinematics, target: Target, reference: np.ndarray) -> RobotIkBatch:
     """Every IK branch of each target; ``reference`` (1, n) or (N, n) [rad]."""
     if kinematics.family is None:
-        from lynxplan.robots.ik.numerical_solver import solve_numerical
-
-        return solve_numerical(kinematics, target, reference)
-    from lynxplan.robots.ik.family_solver import solve_family
-
-    return solve_family(kinematics, target, reference)
+        batch: RobotIkBatch = _solver("numerical_solver").solve_numerical(
+            kinematics, target, reference
+        )
+        return batch
+    family_batch: RobotIkBatch = _solver("family_solver").solve_family(
+        kinematics, target, reference
+    )
+    return family_batch
 
 
 def solve_pose_one(
@@ -41,6 +58,7 @@ def solve_pose_one(
     pose needs the batch path (:func:`solve`) or the arm has no family. ``reference`` (n,)."""
     if kinematics.family is None:
         return None
-    from lynxplan.robots.ik.family_solver import solve_pose_one as family_pose_one
-
-    return family_pose_one(kinematics, pose, reference)
+    result: RobotIkResult | None = _solver("family_solver").solve_pose_one(
+        kinematics, pose, reference
+    )
+    return result
