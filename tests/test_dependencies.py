@@ -26,8 +26,12 @@ def _imported_top_level_modules() -> set[str]:
                 found.update(alias.name.split(".")[0] for alias in node.names)
             elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
                 found.add(node.module.split(".")[0])
-        # Peer scripts run as plain scripts in their own venvs and import their siblings.
-        names |= found - {sibling.stem for sibling in path.parent.glob("*.py")}
+        # Peer scripts run as plain scripts in their own venvs and import their siblings (the
+        # benchmark suite's also import the shared lynxplan/bench/peers/common.py).
+        local = {sibling.stem for sibling in path.parent.glob("*.py")}
+        if path.parent.name == "peer_scripts":
+            local |= {shared.stem for shared in (ROOT / "lynxplan/bench/peers").glob("*.py")}
+        names |= found - local
     return names - set(sys.stdlib_module_names) - {"lynxplan", "__future__"}
 
 
