@@ -169,6 +169,15 @@ def scaled(value: Any, factor: float) -> Any:
     return value
 
 
+def scale_obstacles(entries: list[dict[str, Any]], length: float, angle: float) -> None:
+    """Obstacle entries (dumped ``ObstacleEntry`` mappings) to [m] and [rad], in place: their
+    lengths times ``length``, their ``rpy`` times ``angle`` (the factors to SI)."""
+    for entry in entries:
+        for key in ("min_corner", "centre", "size", "radius", "length"):
+            entry[key] = scaled(entry.get(key), length)
+        entry["rpy"] = scaled(entry.get("rpy"), angle)
+
+
 def scale_translation(pose: Any, factor: float) -> Any:
     """Rows of a 3x4 / 4x4 pose with the translation column times ``factor``."""
     if pose is None:

@@ -66,6 +66,7 @@ from lynxplan.scenarios.base import (
     StrictModel,
     TargetEntry,
     Units,
+    scale_obstacles,
     scale_translation,
     scaled,
 )
@@ -138,10 +139,7 @@ class Input(ScenarioModel):
         length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
         data = super().si_inputs()
         data["units"] = dict(SI_UNITS)
-        for entry in data["obstacles"]:
-            for key in ("min_corner", "centre", "size", "radius", "length"):
-                entry[key] = scaled(entry.get(key), length)
-            entry["rpy"] = scaled(entry.get("rpy"), angle)
+        scale_obstacles(data["obstacles"], length, angle)
         data["start"] = scaled(data["start"], angle)
         goal = data["goal"]
         goal.update(

@@ -22,6 +22,7 @@ from lynxplan.scenarios.base import (
     Units,
     Vector3,
     located_error,
+    scale_obstacles,
     scale_translation,
     scaled,
 )
@@ -212,10 +213,7 @@ class Input(ScenarioModel):
         length, angle = length_factor(self.units.length), angle_factor(self.units.angle)
         data = super().si_inputs()
         data["units"] = dict(SI_UNITS)
-        for entry in data["obstacles"]:
-            for key in ("min_corner", "centre", "size", "radius", "length"):
-                entry[key] = scaled(entry.get(key), length)
-            entry["rpy"] = scaled(entry.get("rpy"), angle)
+        scale_obstacles(data["obstacles"], length, angle)
         for entry in data["waypoints"].values():
             entry["q"] = scaled(entry["q"], angle)
             entry["q_reference"] = scaled(entry["q_reference"], angle)
