@@ -59,8 +59,12 @@ def test_a_robot_name_is_never_a_path(http: httpx.Client, endpoint: str) -> None
     for name in ("/etc/passwd", "/etc/no-such-file-here", "../../../../etc/shadow",
                  str(REPO / "urdf" / "lynxmotion_al5.urdf")):  # fmt: skip
         details[name] = problem(http.post(endpoint, json={**body, "robot": name}), 404, "robot")
-    # the same answer whether the path exists or not: only the caller's own value differs
-    assert len({detail.replace(name, "X") for name, detail in details.items()}) == 1
+    # the same answer whether the path exists or not: only the caller's own value differs (the
+    # server echoes at most 40 characters of it, so the comparison does too, wherever the checkout)
+    def shown(name: str) -> str:
+        return name if len(name) <= 40 else name[:40] + "..."
+
+    assert len({detail.replace(shown(name), "X") for name, detail in details.items()}) == 1
     assert "al5, so100, so101" in details["/etc/passwd"]
 
 
