@@ -2,8 +2,10 @@
 
 Each peer runs from its own virtual environment (:mod:`lynxplan.bench.peers`: ``ompl`` and
 ``pyroboplan`` under ``LYNXPLAN_PEERS_DIR``), on the same start, goal configuration and boxes,
-with a Pinocchio/coal collision model of the robot's URDF (boolean checks at a joint
-resolution of :data:`PEER_RESOLUTION`); its paths are checked by the same dense check as
+with a Pinocchio/coal collision model of the robot as lynxplan's (the URDF's collision meshes
+found by lynxplan's mesh resolver and replaced by the same convex hulls, the same self pairs:
+:func:`lynxplan.bench.peers.peer_urdf`; boolean checks at a joint resolution of
+:data:`PEER_RESOLUTION`); its paths are checked by the same dense check as
 lynxplan's. OMPL's validity checker is a Python callback: its share of OMPL's time and its
 number of calls are reported. A peer that is not installed says so.
 """
@@ -31,8 +33,12 @@ _SCRIPTS = {
 
 
 def _spec(problems: Sequence[Problem]) -> dict[str, Any]:
+    """The peers' JSON problem set (its ``urdf`` is written by :func:`_run`)."""
+    from lynxplan.bench.peers import self_pair_names
+
     return {
-        "urdf": str(suite_robot(problems[0].robot).urdf_path),
+        "robot": problems[0].robot,
+        "self_pairs": self_pair_names(suite_robot(problems[0].robot)),
         "seeds": [0],
         "resolution": PEER_RESOLUTION,
         "time_limit": TIME_LIMIT,
@@ -49,13 +55,15 @@ def _spec(problems: Sequence[Problem]) -> dict[str, Any]:
 
 
 def _run(peer: str, spec: dict[str, Any]) -> list[dict[str, Any]]:
-    from lynxplan.bench.peers import peer_python
+    from lynxplan.bench.peers import peer_python, peer_urdf
 
     with tempfile.TemporaryDirectory() as folder:
         output = Path(folder) / "rows.json"
+        urdf = peer_urdf(suite_robot(spec["robot"]), Path(folder))
         done = subprocess.run(
             [str(peer_python(peer)), str(_SCRIPTS[peer]), str(output)],
-            input=json.dumps(spec), capture_output=True, text=True, check=False, timeout=7200,
+            input=json.dumps({**spec, "urdf": str(urdf)}), capture_output=True, text=True,
+            check=False, timeout=7200,
         )  # fmt: skip
         if done.returncode != 0 or not output.is_file():
             tail = (done.stderr.strip().splitlines() or ["no output"])[-1][:200]

@@ -27,7 +27,7 @@ def main() -> None:
     spec = json.load(sys.stdin)
     results = []
     for problem in spec["problems"]:
-        valid, model = make_validity(spec["urdf"], problem["obstacles"])
+        valid, model = make_validity(spec["urdf"], problem["obstacles"], spec.get("self_pairs"))
         nq = model.nq
         lower, upper = np.array(model.lowerPositionLimit), np.array(model.upperPositionLimit)
         for seed in spec["seeds"]:

@@ -24,7 +24,9 @@ def main() -> None:
     spec = json.load(sys.stdin)
     results = []
     for problem in spec["problems"]:
-        model, _data, geometry, _geometry_data = build(spec["urdf"], problem["obstacles"])
+        model, _data, geometry, _geometry_data = build(
+            spec["urdf"], problem["obstacles"], spec.get("self_pairs")
+        )
         for seed in spec["seeds"]:
             options = RRTPlannerOptions(
                 max_step_size=spec["resolution"],

@@ -82,7 +82,7 @@ def main() -> None:
     spec = json.load(sys.stdin)
     rows = []
     for problem in spec["problems"]:
-        valid, model = make_validity(spec["urdf"], problem["obstacles"])
+        valid, model = make_validity(spec["urdf"], problem["obstacles"], spec.get("self_pairs"))
         rows += [solve_one(spec, problem, valid, model, seed) for seed in spec["seeds"]]
     with open(sys.argv[1], "w", encoding="utf-8") as out:
         json.dump(rows, out)
