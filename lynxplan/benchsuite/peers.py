@@ -21,6 +21,7 @@ from typing import Any
 
 import numpy as np
 
+from lynxplan.benchsuite.families import FAMILIES
 from lynxplan.benchsuite.problem import Problem, suite_robot, yaw_rotation
 from lynxplan.benchsuite.runner import TIME_LIMIT, ProblemResult, dense_check
 
@@ -73,16 +74,15 @@ def _run(peer: str, spec: dict[str, Any]) -> list[dict[str, Any]]:
 
 
 def compare_peers(problems: Sequence[Problem], results: Sequence[ProblemResult]) -> dict[str, Any]:
-    """Per robot and peer: solved, clean, median total, speed-up of lynxplan; for OMPL the
-    callback's share of the time and its calls. ``lines`` (to print) and ``misses`` (goals)."""
+    """Per robot, peer and family (then family "all"): solved, clean, median total, speed-up of
+    lynxplan; for OMPL the callback's share of the time and its calls. ``lines`` (to print),
+    ``misses`` (goals), ``figures`` and ``rows`` (per problem, without the path, with ``clean``)."""
     from lynxplan.bench.peers import peer_python
 
-    out: dict[str, Any] = {"lines": [], "misses": [], "figures": []}
+    out: dict[str, Any] = {"lines": [], "misses": [], "figures": [], "rows": []}
     by_name = {p.name: p for p in problems}
     for robot in sorted({p.robot for p in problems}):
         mine = [p for p in problems if p.robot == robot]
-        ours = [r.total_time for r in results if r.robot == robot and r.solved]
-        lynx_median = float(np.median(ours)) if ours else float("nan")
         for peer in _SCRIPTS:
             if not peer_python(peer).is_file():
                 out["lines"].append(f"peer {peer}: peer not installed ({peer_python(peer)})")
@@ -92,36 +92,53 @@ def compare_peers(problems: Sequence[Problem], results: Sequence[ProblemResult])
             except (RuntimeError, subprocess.TimeoutExpired) as error:
                 out["lines"].append(f"peer {peer} {robot}: could not run: {error}")
                 continue
-            out["figures"].append(_figures(peer, robot, rows, by_name, lynx_median, len(mine)))
-            out["lines"].append(_line(out["figures"][-1]))
-            figure = out["figures"][-1]
+            rows = [_checked(peer, row, by_name[row["problem"]]) for row in rows]
+            out["rows"] += rows
+            families = [f for f in FAMILIES if any(p.family == f for p in mine)]
+            for family in [*families, "all"]:
+                picked = [r for r in rows if family in ("all", by_name[r["problem"]].family)]
+                ours = [r.total_time for r in results if r.robot == robot and r.solved
+                        and family in ("all", r.family)]  # fmt: skip
+                figure = _figures(peer, robot, family, picked, _median(ours))
+                out["figures"].append(figure)
+                out["lines"].append(_line(figure))
             if peer == "ompl" and not figure["speedup"] >= GOAL_SPEEDUP:
                 out["misses"].append(f"{robot}: {figure['speedup']:.1f}x the OMPL median "
                                      f"(goal >= {GOAL_SPEEDUP:g}x)")  # fmt: skip
     return out
 
 
-def _figures(peer: str, robot: str, rows: list[dict[str, Any]], by_name: dict[str, Problem],
-             lynx_median: float, count: int) -> dict[str, Any]:  # fmt: skip
-    solved = [r for r in rows if r["solved"] and len(r["path"]) > 1]
-    arm = suite_robot(robot)
-    clean = sum(dense_check(arm, by_name[r["problem"]], np.array(r["path"])) > 0 for r in solved)
-    totals = [r["plan_time"] + r["simplify_time"] for r in solved]
-    median = float(np.median(totals)) if totals else float("nan")
-    figure = {"peer": peer, "robot": robot, "problems": count, "solved": len(solved),
-              "clean": int(clean), "median_total": median,
+def _median(values: Sequence[float]) -> float:
+    return float(np.median(values)) if len(values) else float("nan")
+
+
+def _checked(peer: str, row: dict[str, Any], problem: Problem) -> dict[str, Any]:
+    """``row`` less its path, with ``peer``, ``family`` and ``clean`` (the dense check)."""
+    path = np.array(row.pop("path"))
+    solved = bool(row["solved"]) and len(path) > 1
+    clean = solved and dense_check(suite_robot(problem.robot), problem, path) > 0.0
+    return {**row, "peer": peer, "family": problem.family, "solved": solved, "clean": clean}
+
+
+def _figures(peer: str, robot: str, family: str, rows: list[dict[str, Any]],
+             lynx_median: float) -> dict[str, Any]:  # fmt: skip
+    solved = [r for r in rows if r["solved"]]
+    median = _median([r["plan_time"] + r["simplify_time"] for r in solved])
+    figure = {"peer": peer, "robot": robot, "family": family, "problems": len(rows),
+              "solved": len(solved), "clean": sum(r["clean"] for r in solved),
+              "median_total": median, "lynxplan_median_total": lynx_median,
               "speedup": median / lynx_median}  # fmt: skip
     if peer == "ompl":
         spent = sum(r["plan_time"] + r["simplify_time"] for r in rows)
         figure["callback_share"] = sum(r["check_time"] for r in rows) / spent if spent else 0.0
-        figure["median_checks"] = float(np.median([r["checks"] for r in rows]))
+        figure["median_checks"] = _median([r["checks"] for r in rows])
     return figure
 
 
 def _line(f: dict[str, Any]) -> str:
-    text = (f"peer {f['peer']:<10} {f['robot']:<6} solved {f['solved']}/{f['problems']}, clean "
-            f"{f['clean']}, median total {f['median_total'] * 1e3:.2f} ms; lynxplan "
-            f"{f['speedup']:.1f}x faster")  # fmt: skip
+    text = (f"peer {f['peer']:<10} {f['robot']:<6} {f['family']:<12} solved "
+            f"{f['solved']}/{f['problems']}, clean {f['clean']}, median total "
+            f"{f['median_total'] * 1e3:.2f} ms; lynxplan {f['speedup']:.1f}x faster")  # fmt: skip
     if "callback_share" in f:
         text += (f"; Python validity callback {100 * f['callback_share']:.0f} % of OMPL's time, "
                  f"median {f['median_checks']:.0f} checks/problem")  # fmt: skip

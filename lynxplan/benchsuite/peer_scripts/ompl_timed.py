@@ -2,7 +2,8 @@
 
 Run by the OMPL venv's python (see lynxplan.bench.peers): JSON problems on stdin (as
 lynxplan/bench/peers/ompl_rrtconnect.py) -> JSON rows in the file argv[1], each with
-``checks`` (validity calls) and ``check_time`` [s] (time inside the callback, plan+simplify).
+``checks`` (validity calls), ``check_time`` [s] (time inside the callback, plan+simplify) and
+``status`` (OMPL's PlannerStatus: "Exact solution", "Timeout", "Invalid start", ...).
 """
 
 from __future__ import annotations
@@ -72,6 +73,7 @@ def solve_one(spec: Any, problem: Any, valid: Any, model: Any, seed: int) -> Any
         "path": path,
         "checks": counter["checks"],
         "check_time": counter["time"],
+        "status": str(status),
     }
 
 
