@@ -67,13 +67,13 @@ def obstacle_bounds_kernel(
     sphere_owner: np.ndarray,
     sphere_local: np.ndarray,
     sphere_radius: np.ndarray,
-    kinds: np.ndarray,
-    centres: np.ndarray,
-    rotations: np.ndarray,
-    sizes: np.ndarray,
+    obstacles: tuple[np.ndarray, ...],
     out: np.ndarray,
 ) -> None:
-    """Sphere lower bound of every (primitive, obstacle) distance: out (N, G, O), in [m]."""
+    """Sphere lower bound of every (primitive, obstacle) distance: out (N, G, O), in [m].
+
+    obstacles: kinds (O,), centres (O, 3), rotations (O, 3, 3), sizes (O, 3), in [m]."""
+    kinds, centres, rotations, sizes = obstacles
     count, primitives = poses.shape[0], poses.shape[1]
     local = np.empty(3)
     for n in range(count):

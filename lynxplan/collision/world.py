@@ -179,16 +179,12 @@ class CollisionWorld:
         obstacle_pairs = ~self.pair_is_self
         if obstacle_pairs.any():
             per_link = np.empty((poses.shape[0], len(self.links), len(self.obstacles)))
-            kinds, centres, rotations, sizes = self._kernel_obstacles
             _kernels.obstacle_bounds_kernel(
                 np.ascontiguousarray(poses),
                 self._sphere_owner,
                 self._sphere_local[:, :3].copy(),
                 self._sphere_radius,
-                kinds,
-                centres,
-                rotations,
-                sizes,
+                tuple(self._kernel_obstacles),
                 per_link,
             )
             bounds[:, obstacle_pairs] = per_link[

@@ -47,20 +47,25 @@ def _compose_into(a: np.ndarray, i: int, b: np.ndarray, j: int, out: np.ndarray,
 
 @numba.njit(cache=True, inline="always")
 def joint_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
-    """World pose of every joint frame at one configuration q (nq,) -> scratch[0] (J, 4, 4)."""
-    joint_poses_upto(q, model, scratch, model[3].shape[0] - 1)
+    """World pose of every joint frame at one configuration q (nq,) -> scratch.joint_poses."""
+    joint_poses_upto(q, model, scratch, model.joint_placements.shape[0] - 1)
 
 
 @numba.njit(cache=True, inline="always")
 def joint_poses_upto(q: np.ndarray, model: Any, scratch: Any, last: int) -> None:
-    """World poses of joint frames 0..last at one configuration q (nq,) -> scratch[0] (a
+    """World poses of joint frames 0..last at one configuration q (nq,) -> scratch.joint_poses (a
     parent's index is below its child's, so those need no other joint).
 
     The joint rotation is applied to the placement's columns directly (a rotation about one
     axis mixes two columns), then composed with the parent's pose.
     """
-    axes, index_q, parents, placement = model[:4]
-    world, local = scratch[0], scratch[1]
+    axes, index_q, parents, placement = (
+        model.axes,
+        model.index_q,
+        model.parents,
+        model.joint_placements,
+    )
+    world, local = scratch.joint_poses, scratch.local
     for i in range(4):
         for j in range(4):
             world[0, i, j] = 1.0 if i == j else 0.0
@@ -80,15 +85,17 @@ def joint_poses_upto(q: np.ndarray, model: Any, scratch: Any, last: int) -> None
 
 @numba.njit(cache=True, inline="always")
 def primitive_pose(g: int, model: Any, scratch: Any) -> None:
-    """World pose of primitive g from the joint poses in scratch[0] -> scratch[3][g]."""
-    _compose_into(scratch[0], model[4][g], model[5], g, scratch[3], g)
+    """World pose of primitive g from scratch.joint_poses -> scratch.prim_poses[g]."""
+    _compose_into(
+        scratch.joint_poses, model.prim_joints[g], model.prim_placements, g, scratch.prim_poses, g
+    )
 
 
 @njit_no_refcount()
 def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
-    """World poses of every primitive at one configuration q (nq,) -> scratch[3] (G, 4, 4)."""
+    """World poses of every primitive at one configuration q (nq,) -> scratch.prim_poses."""
     joint_poses(q, model, scratch)
-    for g in range(model[4].shape[0]):
+    for g in range(model.prim_joints.shape[0]):
         primitive_pose(g, model, scratch)
 
 
@@ -180,7 +187,7 @@ def centre_gap(pa: np.ndarray, a: int, ra: float, pb: np.ndarray, b: int, rb: fl
 
 @numba.njit(cache=True, inline="always")
 def pair_bound(p: int, model: Any, scratch: Any) -> float:
-    """Lower bound of pair p's distance at the poses in scratch[3], in [m]."""
+    """Lower bound of pair p's distance at the poses in scratch.prim_poses, in [m]."""
     return pair_bound_below(p, model, scratch, SAT_SKIP_DISTANCE)
 
 
@@ -189,15 +196,16 @@ def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
     """:func:`pair_bound` where only whether it reaches ``enough`` [m] matters above that: the
     bounding-sphere gap when it is at least ``min(enough, SAT_SKIP_DISTANCE)`` (no separating
     axis test), else the tight bound. Either is a lower bound of the distance."""
-    prim_half, prim_radius, pairs = model[6], model[7], model[8]
-    kinds, centres, poses_b, obstacle_half, obstacle_radius = model[10:15]
-    poses = scratch[3]
+    prim_half, prim_radius, pairs = model.prim_half, model.prim_radius, model.pairs
+    kinds, centres, poses_b = model.obstacle_kinds, model.obstacle_centres, model.obstacle_poses
+    obstacle_half, obstacle_radius = model.obstacle_half, model.obstacle_radius
+    poses = scratch.prim_poses
     a, b = pairs[p, 0], pairs[p, 1]
     skip = min(enough, SAT_SKIP_DISTANCE)
     if pairs[p, 2] == 1:
         gap = centre_gap(poses, a, prim_radius[a], poses, b, prim_radius[b])
         if gap < skip:
-            sat = _separating_axis_gap(poses, a, prim_half, poses, b, prim_half, b, scratch[8])
+            sat = _separating_axis_gap(poses, a, prim_half, poses, b, prim_half, b, scratch.sat)
             gap = max(gap, sat)
         return float(gap)
     if kinds[b] == OBSTACLE_SPHERE:
@@ -207,7 +215,7 @@ def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
     dz = centres[b, 2] - poses[a, 2, 3]
     gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - obstacle_radius[b]
     if gap < skip:
-        sat = _separating_axis_gap(poses, a, prim_half, poses_b, b, obstacle_half, b, scratch[8])
+        sat = _separating_axis_gap(poses, a, prim_half, poses_b, b, obstacle_half, b, scratch.sat)
         gap = max(gap, sat)
     return float(gap)
 
@@ -217,13 +225,13 @@ def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> No
     """Lower bound of the distance of every pair at q (nq,) -> out (P,), in [m] (all pairs at
     once: :func:`lynxplan.planning.lanes.all_pair_bounds`)."""
     primitive_poses(q, model, scratch)
-    all_pair_bounds(model, scratch[3], out)
+    all_pair_bounds(model, scratch.prim_poses, out)
 
 
 @njit_no_refcount()
 def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
     """Smallest pair bound at q (nq,), in [m] (inf without pairs)."""
-    bounds = scratch[18][0]
+    bounds = scratch.grid[0]
     state_bounds(q, model, scratch, bounds)
     best = np.inf
     for p in range(bounds.shape[0]):
@@ -234,17 +242,17 @@ def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
 @njit_no_refcount()
 def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: np.ndarray) -> int:
     """Every pair's bound at q (nq,) -> out (P,), in [m], and the first pair whose bound is at
-    most ``threshold`` [m] (-1: none). The pair that failed last (scratch[9][3]) is tried
+    most ``threshold`` [m] (-1: none). The pair that failed last (scratch.counters[3]) is tried
     alone first (a blocked region usually blocks the same pair): when it fails, -2 - that pair
     is returned and out is not filled."""
     primitive_poses(q, model, scratch)
-    count, last = model[8].shape[0], scratch[9][3]
+    count, last = model.pairs.shape[0], scratch.counters[3]
     if last < count and pair_bound_below(last, model, scratch, threshold) <= threshold:
         return int(-2 - last)
-    all_pair_bounds(model, scratch[3], out)
+    all_pair_bounds(model, scratch.prim_poses, out)
     for p in range(count):
         if out[p] <= threshold:
-            scratch[9][3] = p
+            scratch.counters[3] = p
             return p
     return -1
 
@@ -262,15 +270,16 @@ def point_is_clear(
     """Whether every pair's bound exceeds clearance + STALL_DISTANCE at q_a + s (q_b - q_a).
 
     A quick rejection before an edge walk (a blocked edge usually has a blocked point there):
-    it stops at the first failing pair, trying first the pair that failed last (scratch[9][3]).
+    it stops at the first failing pair, trying first the pair that failed last
+    (scratch.counters[3]).
     When it passes, the edge walk may use its bounds: they are in grid row ``row``
-    (scratch[18][row], (P,), in [m]; the point's parameter s in scratch[20][row]).
+    (scratch.grid[row], (P,), in [m]; the point's parameter s in scratch.grid_at[row]).
     """
-    q = scratch[7]
+    q = scratch.q
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-    scratch[20][row] = s
-    return first_below(q, model, scratch, clearance + STALL_DISTANCE, scratch[18][row]) == -1
+    scratch.grid_at[row] = s
+    return first_below(q, model, scratch, clearance + STALL_DISTANCE, scratch.grid[row]) == -1
 
 
 @numba.njit(cache=True, inline="always")

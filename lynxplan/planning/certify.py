@@ -95,7 +95,7 @@ def _spheres_to_box(
     """Lower bound of the distance of robot primitive a (poses (G, 4, 4)) from the box b of
     poses boxes (N, 4, 4) and half sizes half (N, 3): the exact point distance of each of a's
     covering sphere centres from the box, less the spheres' radius, in [m]."""
-    centres, counts, radii = model[17], model[18], model[19]
+    centres, counts, radii = model.cover_centres, model.cover_counts, model.cover_radii
     best = np.inf  # the smallest squared distance of a centre
     for i in range(counts[a]):
         x0, x1, x2 = _cover_centre(poses, a, centres[a, i])
@@ -114,27 +114,32 @@ def _spheres_to_box(
 
 @numba.njit(cache=True, inline="always")
 def sphere_gap(p: int, model: Any, scratch: Any) -> float:
-    """Covering-sphere lower bound of pair p's distance at the poses in scratch[3], in [m].
+    """Covering-sphere lower bound of pair p's distance at the poses in scratch.prim_poses, in [m].
 
     A robot primitive lies inside the union of its covering spheres (model[17..19]) and inside
-    its box (model[6]: a cylinder's or a mesh hull's bounding box): the bound is the exact
+    its box (model.prim_half: a cylinder's or a mesh hull's bounding box): the bound is the exact
     point distance of one primitive's sphere centres from the other's box, less the spheres'
     radius (for a self pair the larger of the two ways round), from a box obstacle the same (a
     cylinder obstacle is stored as its bounding box, which contains it), from a sphere obstacle
     the centres' distance less both radii.
     """
-    pairs, kinds, poses_b, obstacle_half = model[8], model[10], model[12], model[13]
-    poses = scratch[3]
+    pairs, kinds, poses_b, obstacle_half = (
+        model.pairs,
+        model.obstacle_kinds,
+        model.obstacle_poses,
+        model.obstacle_half,
+    )
+    poses = scratch.prim_poses
     a, b = pairs[p, 0], pairs[p, 1]
     if pairs[p, 2] == 1:
-        half = model[6]
+        half = model.prim_half
         return max(
             _spheres_to_box(poses, a, poses, b, half, model),
             _spheres_to_box(poses, b, poses, a, half, model),
         )
     if kinds[b] != OBSTACLE_SPHERE:
         return _spheres_to_box(poses, a, poses_b, b, obstacle_half, model)
-    centres, counts, radii = model[17], model[18], model[19]
+    centres, counts, radii = model.cover_centres, model.cover_counts, model.cover_radii
     c0, c1, c2 = poses_b[b, 0, 3], poses_b[b, 1, 3], poses_b[b, 2, 3]
     best = np.inf
     for i in range(counts[a]):
@@ -146,11 +151,11 @@ def sphere_gap(p: int, model: Any, scratch: Any) -> float:
 
 @numba.njit(cache=True, inline="always")
 def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: Any) -> None:
-    q = scratch[7]
+    q = scratch.q
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
     joint_poses(q, model, scratch)
-    for g in range(model[4].shape[0]):
+    for g in range(model.prim_joints.shape[0]):
         primitive_pose(g, model, scratch)
 
 
@@ -158,7 +163,7 @@ def _poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: A
 def _bound_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
 ) -> float:
-    """Pair p's tight bound at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
+    """Pair p's tight bound at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch.arms[side]."""
     pose_pair_at(q_a, q_b, s, p, model, scratch, side)
     return float(pair_bound(p, model, scratch))
 
@@ -166,7 +171,7 @@ def _bound_at(
 @njit_refcounted()
 def segment_rates(path: np.ndarray, model: Any) -> np.ndarray:
     """Motion bound of every pair per unit s on every segment: (M, nq) -> (M - 1, P), in [m]."""
-    rates = model[9]
+    rates = model.rates
     out = np.zeros((path.shape[0] - 1, rates.shape[0]))
     for k in range(path.shape[0] - 1):
         for p in range(rates.shape[0]):
@@ -183,9 +188,9 @@ def _end_bounds(
 ) -> None:
     """Sphere gaps out[0] and tight bounds out[1] of every pair at s = end: out (2, P)."""
     _poses_at(q_a, q_b, end, model, scratch)
-    for p in range(model[8].shape[0]):
+    for p in range(model.pairs.shape[0]):
         out[0, p] = sphere_gap(p, model, scratch)
-    all_pair_bounds(model, scratch[3], out[1])
+    all_pair_bounds(model, scratch.prim_poses, out[1])
 
 
 @njit_no_refcount()
@@ -197,7 +202,7 @@ def _sphere_chain(
     :func:`lynxplan.planning.lanes.spheres_along`), whose consecutive gaps exceed the motion bound
     between them (:func:`lynxplan.planning.validity.span_motion`) or that lie within the
     previous point's one-sided reach (:func:`lynxplan.planning.edge_walk.reach_step`)."""
-    arms = scratch[13]
+    arms = scratch.arms
     if gap <= 0.0:
         return False
     for side in range(2):  # lever arms at both ends (one inlined copy of the pose code)
@@ -205,10 +210,10 @@ def _sphere_chain(
     gap_end = float(sphere_gap(p, model, scratch))  # at s = 1 (gap at 0: the caller's)
     if gap_end > 0.0 and gap + gap_end > span_motion(p, 1.0, model, scratch):
         return True  # one two-sided interval: the whole segment
-    if model[0].shape[0] > MAX_JOINTS:  # too many joints for the lanes: the exact chain
+    if model.axes.shape[0] > MAX_JOINTS:  # too many joints for the lanes: the exact chain
         return False
     s, trend = 0.0, 0.0
-    out = scratch[17]
+    out = scratch.lanes
     one = reach_step(gap, p, arms, 0, model, scratch)
     for _ in range(SPHERE_STEPS // LANES):
         if s + one >= 1.0 or not place_lanes(s, gap, one, trend, out):
@@ -216,7 +221,7 @@ def _sphere_chain(
         spheres_along(q_a, q_b, p, model, out)
         progressed, i = False, 0
         while i < LANES and s + one < 1.0:
-            best = farthest_lane(i, s, gap, one, p, model, scratch, OUT_SPHERE, 0.0, 0.0)
+            best = farthest_lane(i, (s, gap, one), p, model, scratch, (OUT_SPHERE, 0.0, 0.0))
             if best < 0:
                 break
             t, gap_t = out[OUT_S, best], out[OUT_SPHERE, best]
@@ -254,8 +259,8 @@ def _sphere_grid(
         for p in range(todo.shape[0]):
             if todo[p]:
                 gaps[i, p] = sphere_gap(p, model, scratch)
-                lever_arms(p, scratch[0], scratch[3], model, arms, i * count + p)
-    side = scratch[13]
+                lever_arms(p, scratch.joint_poses, scratch.prim_poses, model, arms, i * count + p)
+    side = scratch.arms
     for p in range(todo.shape[0]):
         if not todo[p]:
             continue
@@ -299,10 +304,10 @@ def _chain(
     motion column holds, for each row but the last of the chain, the bound of the pair's motion
     until the next row (the verifier's test); a jump to s = 1 gets the static bound."""
     parameter, pair, motion = rows[1], rows[2], rows[3]
-    arms = scratch[13]
+    arms = scratch.arms
     static = 0.0
     for j in range(q_a.shape[0]):
-        static += model[9][p, j] * scratch[14][j]
+        static += model.rates[p, j] * scratch.dq[j]
     s, b, trend = 0.0, ends[0], 0.0  # trend: the bound's change per unit s at the last step
     pose_pair_at(q_a, q_b, 0.0, p, model, scratch, 0)  # its lever arms (b: the caller's)
     while True:
@@ -347,18 +352,18 @@ def _segment_ends(
 ) -> None:
     """Sphere gaps and tight bounds of every pair at both ends of segment k (start, end: (2, P),
     see :func:`_end_bounds`; start is the previous segment's end), |path[k+1] - path[k]| ->
-    scratch[14]; the waypoints' bounds and poses (waypoints: (M, P), (M, G, 4, 4)) filled."""
+    scratch.dq; the waypoints' bounds and poses (waypoints: (M, P), (M, G, 4, 4)) filled."""
     bounds, poses = waypoints
     for j in range(path.shape[1]):
-        scratch[14][j] = abs(path[k + 1, j] - path[k, j])
+        scratch.dq[j] = abs(path[k + 1, j] - path[k, j])
     if k == 0:
         _end_bounds(path[k], path[k + 1], 0.0, model, scratch, start)
-        poses[k] = scratch[3]  # (k, not a literal 0: numba cannot assign an array there)
+        poses[k] = scratch.prim_poses  # (k, not a literal 0: numba cannot assign an array there)
         bounds[k] = start[1]
     else:
         start[:] = end
     _end_bounds(path[k], path[k + 1], 1.0, model, scratch, end)
-    poses[k + 1] = scratch[3]
+    poses[k + 1] = scratch.prim_poses
     bounds[k + 1] = end[1]
 
 
@@ -382,7 +387,7 @@ def schedule(path: np.ndarray, model: Any, scratch: Any, rows: Any, waypoints: A
     distance (about one query per pair near an obstacle and inner waypoint).
     """
     segment, parameter, pair, motion, source = rows
-    count_pairs = model[8].shape[0]
+    count_pairs = model.pairs.shape[0]
     rates = segment_rates(path, model)
     start, end = np.empty((2, count_pairs)), np.empty((2, count_pairs))
     todo = np.empty(count_pairs, dtype=np.bool_)
@@ -441,7 +446,7 @@ def configuration_poses(
     for r in range(segment.shape[0]):
         k = segment[r]
         _poses_at(path[k], path[k + 1], parameter[r], model, scratch)
-        out[r] = scratch[3]
+        out[r] = scratch.prim_poses
 
 
 @numba.njit(cache=True)
@@ -458,7 +463,7 @@ def row_transforms(
     """World poses of each row's two primitives at its configuration (the second only for a
     self pair): rotation (R, 2, 3, 3), translation (R, 2, 3), in [m] (contiguous, ready for
     coal). Only the joints up to the pair's primitives are posed."""
-    q, pairs, joint_of, poses = scratch[7], model[8], model[4], scratch[3]
+    q, pairs, joint_of, poses = scratch.q, model.pairs, model.prim_joints, scratch.prim_poses
     for r in range(segment.shape[0]):
         k, s, p = segment[r], parameter[r], pair[r]
         for j in range(path.shape[1]):
@@ -485,8 +490,8 @@ def waypoint_bounds(
     waypoint of path (N, nq), in one call."""
     for n in range(path.shape[0]):
         primitive_poses(path[n], model, scratch)
-        poses[n] = scratch[3]
-        all_pair_bounds(model, scratch[3], bounds[n])
+        poses[n] = scratch.prim_poses
+        all_pair_bounds(model, scratch.prim_poses, bounds[n])
 
 
 @numba.njit(cache=True)

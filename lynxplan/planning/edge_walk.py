@@ -75,7 +75,7 @@ def lever_arms(
     the distance of its centre from the axis plus its bounding radius; 0 when j moves neither.
     (Rows are indexed, not sliced: no reference counting in the compiled hot loops.)
     """
-    axes, radius, owners, joints = model[0], model[7], model[15], model[16]
+    axes, radius, owners, joints = model.axes, model.prim_radius, model.owners, model.joint_of_q
     for j in range(out.shape[1]):
         g = owners[p, j]
         joint = joints[j]
@@ -98,12 +98,12 @@ def reach_step(slack: float, p: int, arms: np.ndarray, row: int, model: Any, scr
 
     A point of the moving primitive moves at most ``sum_j |dq_j| rho_j`` per unit s, rho_j its
     distance from joint j's axis; rho_j at s is at most ``arms[j]``, never more than the static
-    reach ``R_j`` (``model[9]``), and grows at most at the speed of the point relative to joint
+    reach ``R_j`` (``model.rates``), and grows at most at the speed of the point relative to joint
     j's frame, ``L = sum_i R_i |dq_i|`` (only joints between j and the primitive move it there).
     So the motion over ds is at most ``min(L ds, V ds + L D ds^2 / 2)`` with ``V = sum_j |dq_j|
     min(R_j, arms_j)`` and ``D = sum_j |dq_j|`` over the pair's joints.
     """
-    rates, dq = model[9], scratch[14]
+    rates, dq = model.rates, scratch.dq
     static = lever = spread = 0.0
     for j in range(dq.shape[0]):
         if rates[p, j] > 0.0:
@@ -119,12 +119,12 @@ def reach_step(slack: float, p: int, arms: np.ndarray, row: int, model: Any, scr
 @numba.njit(cache=True, inline="always")
 def span_motion(p: int, ds: float, model: Any, scratch: Any) -> float:
     """Bound of pair p's motion over an interval of length ds (of s) between two points whose
-    lever arms are scratch[13][0] and scratch[13][1], in [m].
+    lever arms are scratch.arms[0] and scratch.arms[1], in [m].
 
     In between, rho_j is at most the smaller of ``rho_j(s) + L (u - s)`` and ``rho_j(t) +
     L (t - u)``, hence at most their mean ``(rho_j(s) + rho_j(t) + L ds) / 2``, and at most R_j.
     """
-    rates, dq, arms = model[9], scratch[14], scratch[13]
+    rates, dq, arms = model.rates, scratch.dq, scratch.arms
     static = 0.0
     for j in range(dq.shape[0]):
         static += rates[p, j] * dq[j]
@@ -141,8 +141,8 @@ def pose_pair_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
 ) -> None:
     """Pair p's primitives posed at q_a + s (q_b - q_a) (joints beyond them left alone: they
-    move neither); its lever arms -> scratch[13][side]."""
-    q, pairs, joint_of = scratch[7], model[8], model[4]
+    move neither); its lever arms -> scratch.arms[side]."""
+    q, pairs, joint_of = scratch.q, model.pairs, model.prim_joints
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
     last = joint_of[pairs[p, 0]]
@@ -152,17 +152,17 @@ def pose_pair_at(
     primitive_pose(pairs[p, 0], model, scratch)
     if pairs[p, 2] == 1:
         primitive_pose(pairs[p, 1], model, scratch)
-    lever_arms(p, scratch[0], scratch[3], model, scratch[13], side)
+    lever_arms(p, scratch.joint_poses, scratch.prim_poses, model, scratch.arms, side)
 
 
 @numba.njit(cache=True, inline="always")
 def _pair_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
 ) -> float:
-    """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch[13][side]."""
+    """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch.arms[side]."""
     pose_pair_at(q_a, q_b, s, p, model, scratch, side)
-    scratch[9][1] += 1
-    scratch[9][2] += 1
+    scratch.counters[1] += 1
+    scratch.counters[2] += 1
     return float(pair_bound(p, model, scratch))
 
 
@@ -183,7 +183,7 @@ def state_slacks(
 ) -> bool:
     """Every pair's bound minus the clearance at q (nq,) -> out (P,), in [m]; whether all exceed
     :data:`STALL_DISTANCE` (out is only complete when they do). The pair that failed last
-    (scratch[9][3]) is tried alone first (:func:`lynxplan.planning.validity.first_below`)."""
+    (scratch.counters[3]) is tried alone first (:func:`lynxplan.planning.validity.first_below`)."""
     if first_below(q, model, scratch, clearance + STALL_DISTANCE, out) != -1:
         return False
     for p in range(out.shape[0]):
@@ -208,23 +208,23 @@ def edge_fraction(
 def edge_fraction_from(
     q_a: np.ndarray,
     q_b: np.ndarray,
-    slack_a: np.ndarray,
-    slack_b: np.ndarray,
+    slacks: tuple[np.ndarray, np.ndarray],
     points: int,
     model: Any,
     scratch: Any,
     clearance: float,
     moved: int,
 ) -> float:
-    """:func:`edge_fraction` with the pairs' slacks at q_a and q_b already known (slack_a,
-    slack_b (P,), in [m], from :func:`state_slacks` at exactly q_a and q_b: tree nodes',
+    """:func:`edge_fraction` with the pairs' slacks at q_a and q_b already known (slacks, two
+    (P,) arrays, in [m], from :func:`state_slacks` at exactly q_a and q_b: tree nodes',
     computed once), and every pair's bound at ``points`` grid points of this edge (grid rows
     0..points-1: quick tests :func:`lynxplan.planning.validity.point_is_clear` that passed
     just before, in increasing order of s).
 
     ``moved``: the joints (bit j: joint j) in which the edge may differ from a certified one
     (:func:`edge_walk`), or :data:`ALL_JOINTS`."""
-    start, end = scratch[4], scratch[19]
+    slack_a, slack_b = slacks
+    start, end = scratch.slack, scratch.end
     for p in range(start.shape[0]):
         start[p] = slack_a[p]
         end[p] = slack_b[p]
@@ -259,8 +259,8 @@ ALL_JOINTS = -1
 _JOINT_BITS = 62
 
 #: Flags of :func:`edge_walk`'s ``grid``: the pairs' slacks at the edge's end are in
-#: scratch[19] (END_KNOWN); plus POINT times the number of grid points: every pair's bounds at
-#: them are grid rows scratch[18][i], (P,), at edge parameters scratch[20][i], increasing.
+#: scratch.end (END_KNOWN); plus POINT times the number of grid points: every pair's bounds at
+#: them are grid rows scratch.grid[i], (P,), at edge parameters scratch.grid_at[i], increasing.
 END_KNOWN, POINT = 1, 2
 
 
@@ -268,13 +268,13 @@ END_KNOWN, POINT = 1, 2
 def _grid_start(
     p: int, static: float, points: int, model: Any, scratch: Any, clearance: float
 ) -> None:
-    """Where pair p's walk starts (scratch[6][p], its slack, lever arms and reach) and the grid
-    point from which the grid certifies it to the edge's end (scratch[21][p]), or nothing to
+    """Where pair p's walk starts (scratch.where[p], its slack, lever arms and reach) and the grid
+    point from which the grid certifies it to the edge's end (scratch.tail[p]), or nothing to
     walk (reach infinite), from the two-sided static test (motion bound ``static`` [m] per unit
     s) on the intervals i = 0..points between the grid points s_{i-1} and s_i (s_{-1} = 0,
     s_points = 1; :func:`_walk_start`)."""
-    slack, reach, where, all_arms = scratch[4], scratch[5], scratch[6], scratch[15]
-    end, bounds, at, tail = scratch[19], scratch[18], scratch[20], scratch[21]
+    slack, reach, where, all_arms = scratch.slack, scratch.reach, scratch.where, scratch.all_arms
+    end, bounds, at, tail = scratch.end, scratch.grid, scratch.grid_at, scratch.tail
     first = last = -1  # the first and the last interval not certified
     before, sigma = 0.0, slack[p]
     for i in range(points + 1):
@@ -293,10 +293,10 @@ def _grid_start(
     tail[p] = at[last] if last < points else np.inf
     if first > 0:  # certified up to grid point first - 1: the walk starts there
         where[p], slack[p] = at[first - 1], bounds[first - 1, p] - clearance
-        copy_row(all_arms, p, model[9], p)  # lever arms at most the static reach
+        copy_row(all_arms, p, model.rates, p)  # lever arms at most the static reach
         reach[p] = where[p] + reach_step(slack[p], p, all_arms, p, model, scratch)
         return
-    lever_arms(p, scratch[0], scratch[3], model, all_arms, p)
+    lever_arms(p, scratch.joint_poses, scratch.prim_poses, model, all_arms, p)
     reach[p] = reach_step(slack[p], p, all_arms, p, model, scratch)
 
 
@@ -338,15 +338,15 @@ def _walk_start(
     between the edge's ends and the grid points (``grid``)
     where its bounds are known: two-sided on [s, t] when the slacks at s and t sum to more
     than L (t - s) (the test of :func:`span_motion` with the static bound). A pair whose
-    intervals pass up to a grid point starts its walk there (scratch[6]); one whose intervals
+    intervals pass up to a grid point starts its walk there (scratch.where); one whose intervals
     pass from a grid point to the end is certified to the end once its walk reaches that point
-    (scratch[21], infinite when not). A pair that no joint of ``moved`` moves (:func:`edge_walk`)
+    (scratch.tail, infinite when not). A pair that no joint of ``moved`` moves (:func:`edge_walk`)
     is certified at once.
     """
-    pairs, rates = model[8], model[9]
+    pairs, rates = model.pairs, model.rates
     count = pairs.shape[0]
-    dq, counters, slack = scratch[14], scratch[9], scratch[4]
-    end, reach, where, trend = scratch[19], scratch[5], scratch[6], scratch[16]
+    dq, counters, slack = scratch.dq, scratch.counters, scratch.slack
+    end, reach, where, trend = scratch.end, scratch.reach, scratch.where, scratch.trend
     points = grid // POINT
     for j in range(q_a.shape[0]):
         dq[j] = abs(q_b[j] - q_a[j])
@@ -355,12 +355,12 @@ def _walk_start(
     counters[2] += count
     if grid & END_KNOWN == 0:
         primitive_poses(q_b, model, scratch)
-        all_pair_bounds(model, scratch[3], end)
+        all_pair_bounds(model, scratch.prim_poses, end)
         for p in range(count):
             end[p] -= clearance
     primitive_poses(q_a, model, scratch)
     if not known:
-        all_pair_bounds(model, scratch[3], slack)
+        all_pair_bounds(model, scratch.prim_poses, slack)
         for p in range(count):
             slack[p] -= clearance
     for p in range(count):
@@ -417,23 +417,22 @@ def place_lanes(s: float, sigma: float, one: float, trend: float, out: np.ndarra
 @numba.njit(cache=True, inline="always")
 def farthest_lane(
     i: int,
-    s: float,
-    slack: float,
-    own: float,
+    start: tuple[float, float, float],
     p: int,
     model: Any,
     scratch: Any,
-    row: int,
-    offset: float,
-    floor: float,
+    level: tuple[int, float, float],
 ) -> int:
-    """The farthest lane k >= i of a vectorised run (scratch[17]) certified from s (slack
-    [m], lever arms scratch[13][0], one-sided reach s + own): the lane's slack
-    ``scratch[17][row, k] - offset`` above ``floor``, and k within the reach or passing the
-    two-sided test (:func:`span_motion`); scanning forward until a lane fails after one passed.
-    -1: none; -2 - k: lane k, the first lane after s, has its slack at or below ``floor`` (a
-    wall for the edge walk; the sphere chains stop there too)."""
-    out, arms = scratch[17], scratch[13]
+    """The farthest lane k >= i of a vectorised run (scratch.lanes) certified from start = (s,
+    slack [m], one-sided step own) (lever arms scratch.arms[0], one-sided reach s + own): the
+    lane's slack ``scratch.lanes[row, k] - offset`` above ``floor`` (level = (row, offset,
+    floor)), and k within the reach or passing the two-sided test (:func:`span_motion`);
+    scanning forward until a lane fails after one passed. -1: none; -2 - k: lane k, the first
+    lane after s, has its slack at or below ``floor`` (a wall for the edge walk; the sphere
+    chains stop there too)."""
+    s, slack, own = start
+    row, offset, floor = level
+    out, arms = scratch.lanes, scratch.arms
     best = -1
     for k in range(i, LANES):
         t = out[OUT_S, k]
@@ -482,8 +481,13 @@ def _lane_run(
     Returns 1 when a point was accepted; -t when the first point t lies within the pair's
     one-sided reach ``nearest`` (certified to t) and its slack is within STALL_DISTANCE (the
     walk stops there, as a single step would); 0 otherwise (the caller takes a single step)."""
-    slack, reach, where, arms = scratch[4], scratch[5], scratch[6], scratch[13]
-    all_arms, trend, out, counters = scratch[15], scratch[16], scratch[17], scratch[9]
+    slack, reach, where, arms = scratch.slack, scratch.reach, scratch.where, scratch.arms
+    all_arms, trend, out, counters = (
+        scratch.all_arms,
+        scratch.trend,
+        scratch.lanes,
+        scratch.counters,
+    )
     s, sigma = where[p], slack[p]
     if not place_lanes(s, sigma, nearest - s, trend[p], out):
         return 0.0
@@ -495,7 +499,7 @@ def _lane_run(
     own = reach_step(sigma, p, arms, 0, model, scratch)
     while i < LANES:
         best = farthest_lane(
-            i, s, sigma, own, p, model, scratch, OUT_BOUND, clearance, STALL_DISTANCE
+            i, (s, sigma, own), p, model, scratch, (OUT_BOUND, clearance, STALL_DISTANCE)
         )
         if best < -1:  # a wall at the first point
             t = float(out[OUT_S, -2 - best])
@@ -539,8 +543,8 @@ def _two_sided_step(
     ends' slacks its motion bound (:func:`span_motion`); the pair's state then moves to t.
     A compiled call, not inlined: a walk with lanes never comes here, and each inlined copy of
     the pose code lengthens :func:`edge_walk`'s first compile."""
-    slack, reach, where = scratch[4], scratch[5], scratch[6]
-    all_arms, trend = scratch[15], scratch[16]
+    slack, reach, where = scratch.slack, scratch.reach, scratch.where
+    all_arms, trend = scratch.all_arms, scratch.trend
     slack_t = _pair_at(q_a, q_b, t, p, model, scratch, 1) - clearance
     if not (
         slack_t > STALL_DISTANCE and slack[p] + slack_t > span_motion(p, t - s, model, scratch)
@@ -548,7 +552,7 @@ def _two_sided_step(
         return False
     trend[p] = (slack_t - slack[p]) / (t - s)
     where[p], slack[p] = t, slack_t
-    copy_row(all_arms, p, scratch[13], 1)
+    copy_row(all_arms, p, scratch.arms, 1)
     reach[p] = t + reach_step(slack_t, p, all_arms, p, model, scratch)
     return True
 
@@ -565,7 +569,7 @@ def edge_walk(
     moved: int,
 ) -> float:
     """Conservative advancement from q_a towards q_b: the certified fraction s in [0, 1]; with
-    ``known``, scratch[4] holds the pairs' slacks at q_a; ``grid``: what else is known
+    ``known``, scratch.slack holds the pairs' slacks at q_a; ``grid``: what else is known
     (:data:`END_KNOWN`, grid points; :func:`_walk_start` certifies most pairs with them).
 
     ``moved``: :data:`ALL_JOINTS`, or a bit set of joints (bit j: joint j) when the caller
@@ -589,13 +593,13 @@ def edge_walk(
     Callers pass ``known`` and ``grid`` as ``np.bool_``/``np.int64``: numba compiles a function
     once per literal argument value, and this walk takes about a minute to compile.
     """
-    count = model[8].shape[0]
-    counters, slack = scratch[9], scratch[4]
-    reach, where, arms, all_arms = scratch[5], scratch[6], scratch[13], scratch[15]
-    trend, tail = scratch[16], scratch[21]
+    count = model.pairs.shape[0]
+    counters, slack = scratch.counters, scratch.slack
+    reach, where, arms, all_arms = scratch.reach, scratch.where, scratch.arms, scratch.all_arms
+    trend, tail = scratch.trend, scratch.tail
     if not _walk_start(q_a, q_b, model, scratch, clearance, known, grid, moved):
         return -1.0
-    lanes = model[0].shape[0] <= MAX_JOINTS and q_a.shape[0] <= MAX_JOINTS
+    lanes = model.axes.shape[0] <= MAX_JOINTS and q_a.shape[0] <= MAX_JOINTS
     while True:
         p, nearest = np.int64(0), np.inf  # (a literal 0 would compile pair_along twice)
         for k in range(count):

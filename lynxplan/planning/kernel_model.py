@@ -11,7 +11,7 @@ without numba's reference counting, their work rows on their stack.
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any, TypeVar, cast
+from typing import Any, NamedTuple, TypeVar, cast
 
 import numba
 import numpy as np
@@ -108,18 +108,108 @@ def stack_array(rows: int, columns: int) -> Any:
     return allocate
 
 
-def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Kernel arrays of a world for the given pairs (rows ``(a, b, is_self)``, shape (P, 3)).
+class KernelModel(NamedTuple):
+    """The arrays of the checker's kernels for one world and its checked pairs (contiguous).
 
-    Layout: 0 joint axes, 1 joint configuration indices, 2 joint parents, 3 joint placements,
-    4 primitive joints, 5 primitive placements, 6 primitive box half sizes, 7 primitive bounding
-    radii, 8 pairs, 9 pair motion rates (P, nq) [m/rad], 10 obstacle kinds, 11 obstacle centres,
-    12 obstacle poses, 13 obstacle half sizes, 14 obstacle bounding radii, 15 pair joint owners
-    (P, nq): the primitive of the pair that joint j moves relative to the other side (-1: none),
-    16 the joint (frame) index of each configuration index (nq,), 17 primitive covering sphere
-    centres (G, K, 3) in the primitive frame, 18 their counts (G,), 19 their radii (G,)
-    (:func:`_cover_arrays`).
+    J joint frames, G primitives, P pairs, O obstacles, nq configuration indices.
     """
+
+    #: Rotation axis (0, 1, 2 for x, y, z) of each joint frame, (J,).
+    axes: np.ndarray
+    #: Configuration index of each joint frame, (J,).
+    index_q: np.ndarray
+    #: Parent frame of each joint frame, (J,) (a parent's index is below its child's).
+    parents: np.ndarray
+    #: Placement of each joint frame in its parent's, (J, 4, 4), in [m].
+    joint_placements: np.ndarray
+    #: Joint frame each primitive hangs on, (G,).
+    prim_joints: np.ndarray
+    #: Placement of each primitive in its joint frame, (G, 4, 4), in [m].
+    prim_placements: np.ndarray
+    #: Half sizes of each primitive's box (a cylinder's or mesh hull's bounding box), (G, 3), [m].
+    prim_half: np.ndarray
+    #: Bounding-sphere radius of each primitive, (G,), in [m].
+    prim_radius: np.ndarray
+    #: Checked pairs, rows (a, b, is_self), (P, 3): b an obstacle unless is_self.
+    pairs: np.ndarray
+    #: Motion of each pair per radian of each joint, (P, nq), in [m/rad] (:func:`pair_rates`).
+    rates: np.ndarray
+    #: Kind of each obstacle, (O,): :data:`OBSTACLE_BOX` or :data:`OBSTACLE_SPHERE`.
+    obstacle_kinds: np.ndarray
+    #: Centre of each obstacle, (O, 3), in [m].
+    obstacle_centres: np.ndarray
+    #: Pose of each obstacle, (O, 4, 4), in [m].
+    obstacle_poses: np.ndarray
+    #: Half sizes of each obstacle's box (a sphere's radius in column 0), (O, 3), in [m].
+    obstacle_half: np.ndarray
+    #: Bounding-sphere radius of each obstacle, (O,), in [m].
+    obstacle_radius: np.ndarray
+    #: The primitive of each pair that each joint moves relative to the other side, (P, nq)
+    #: (-1: none; :func:`pair_owners`).
+    owners: np.ndarray
+    #: The joint frame of each configuration index, (nq,) (-1: none).
+    joint_of_q: np.ndarray
+    #: Covering-sphere centres of each primitive in its frame, (G, K, 3), in [m].
+    cover_centres: np.ndarray
+    #: Covering spheres of each primitive, (G,).
+    cover_counts: np.ndarray
+    #: Covering-sphere radius of each primitive, (G,), in [m].
+    cover_radii: np.ndarray
+
+
+class Scratch(NamedTuple):
+    """Work arrays of the kernels for one :class:`KernelModel` (J joints, G primitives, P pairs)."""
+
+    #: World pose of every joint frame, (J, 4, 4).
+    joint_poses: np.ndarray
+    #: One joint's local pose, (1, 4, 4).
+    local: np.ndarray
+    #: World pose of every primitive, (G, 4, 4).
+    prim_poses: np.ndarray
+    #: Each pair's slack (bound minus clearance) where its walk stands, (P,), in [m].
+    slack: np.ndarray
+    #: The point of the edge each pair is certified to, (P,).
+    reach: np.ndarray
+    #: The point of the edge where each pair's walk stands, (P,).
+    where: np.ndarray
+    #: A configuration, (nq,), in [rad].
+    q: np.ndarray
+    #: The separating-axis test's work rows, (3, 3).
+    sat: np.ndarray
+    #: Counters: edge checks, advancement steps, pair bounds evaluated, the pair that last
+    #: failed a quick test (4,).
+    counters: np.ndarray
+    #: Lever arms of the pair being walked at two points of the edge, (2, nq), in [m].
+    arms: np.ndarray
+    #: |joint steps| of the edge, (nq,), in [rad].
+    dq: np.ndarray
+    #: Each pair's lever arms where its walk stands, (P, nq), in [m].
+    all_arms: np.ndarray
+    #: Each pair's slack trend on the edge, (P,), in [m per unit s].
+    trend: np.ndarray
+    #: Output rows of the vectorised kernels, (3 + nq, LANES).
+    lanes: np.ndarray
+    #: Every pair's bound at up to :data:`GRID_POINTS` points of an edge, (GRID_POINTS, P).
+    grid: np.ndarray
+    #: Every pair's slack at an edge's end, (P,), in [m].
+    end: np.ndarray
+    #: The grid points' edge parameters, (GRID_POINTS,).
+    grid_at: np.ndarray
+    #: The point from which the grid certifies each pair to the edge's end, (P,).
+    tail: np.ndarray
+
+
+class CheckData(NamedTuple):
+    """What the kernels of a validity checker take: its model, its scratch and the clearance."""
+
+    model: KernelModel
+    scratch: Scratch
+    #: Required distance between the robot and anything else, in [m].
+    clearance: float
+
+
+def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> KernelModel:
+    """Kernel arrays of a world for the given pairs (rows ``(a, b, is_self)``, shape (P, 3))."""
     axes, index_q, parents, placements, prim_joints, prim_placements = world._kernel_joints
     half = np.array([_box_half_extents(p.kind, p.half_extents) for p in world.links])
     kinds, centres, rotations, obstacle_half, obstacle_radius = _obstacle_arrays(world)
@@ -143,7 +233,7 @@ def kernel_model(world: CollisionWorld, pairs: np.ndarray) -> tuple[np.ndarray, 
         _joint_of_coordinate(world),
         *_cover_arrays(world),
     )
-    return tuple(np.ascontiguousarray(a) for a in arrays)
+    return KernelModel(*(np.ascontiguousarray(a) for a in arrays))
 
 
 def _cover_arrays(world: CollisionWorld) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -168,39 +258,29 @@ def world_pairs(world: CollisionWorld) -> np.ndarray:
     return np.asarray(rows, dtype=np.int64).reshape(-1, 3)
 
 
-def make_scratch(model: tuple[np.ndarray, ...]) -> tuple[np.ndarray, ...]:
-    """Work arrays of the kernels for one model: joint and primitive poses, bounds, rates, and
-    counters (edge checks, advancement steps, pair bounds evaluated) and the pair that last
-    failed a quick state test, the joint and primitive poses at an edge's start, the joints'
-    lever arms at two points of an edge, the joint steps of an edge, every pair's lever arms
-    and slack trend on an edge, the output rows of :func:`lynxplan.planning.lanes.pair_along`,
-    every pair's bound at up to :data:`GRID_POINTS` points of an edge (the quick tests before a
-    walk), every pair's slack at an edge's end, the grid points' edge parameters, and the point
-    of an edge from which each pair is certified to its end by the grid."""
-    joints, pairs, nq = len(model[0]), len(model[8]), model[9].shape[1]
-    return (
-        np.empty((joints, 4, 4)),
-        np.empty((1, 4, 4)),
-        np.zeros((4, 4)),
-        np.empty((len(model[4]), 4, 4)),
-        np.empty(pairs),
-        np.empty(pairs),
-        np.empty(pairs),
-        np.empty(nq),
-        np.empty((3, 3)),
-        np.zeros(4, dtype=np.int64),
-        np.zeros(len(model[4]), dtype=np.int64),
-        np.empty((joints, 4, 4)),
-        np.empty((len(model[4]), 4, 4)),
-        np.empty((2, nq)),
-        np.empty(nq),
-        np.empty((pairs, nq)),
-        np.empty(pairs),
-        np.empty((3 + nq, LANES)),
-        np.empty((GRID_POINTS, pairs)),
-        np.empty(pairs),
-        np.empty(GRID_POINTS),
-        np.empty(pairs),
+def make_scratch(model: KernelModel) -> Scratch:
+    """Work arrays of the kernels for one model (:class:`Scratch`)."""
+    joints, pairs, nq = len(model.axes), len(model.pairs), model.rates.shape[1]
+    primitives = len(model.prim_joints)
+    return Scratch(
+        joint_poses=np.empty((joints, 4, 4)),
+        local=np.empty((1, 4, 4)),
+        prim_poses=np.empty((primitives, 4, 4)),
+        slack=np.empty(pairs),
+        reach=np.empty(pairs),
+        where=np.empty(pairs),
+        q=np.empty(nq),
+        sat=np.empty((3, 3)),
+        counters=np.zeros(4, dtype=np.int64),
+        arms=np.empty((2, nq)),
+        dq=np.empty(nq),
+        all_arms=np.empty((pairs, nq)),
+        trend=np.empty(pairs),
+        lanes=np.empty((3 + nq, LANES)),
+        grid=np.empty((GRID_POINTS, pairs)),
+        end=np.empty(pairs),
+        grid_at=np.empty(GRID_POINTS),
+        tail=np.empty(pairs),
     )
 
 

@@ -35,6 +35,7 @@ from lynxplan._fastmath import sincos
 from lynxplan.planning.kernel_model import (
     LANES,
     OBSTACLE_SPHERE,
+    KernelModel,
     njit_no_refcount,
     njit_refcounted,
     stack_array,
@@ -67,9 +68,9 @@ _lane_rows = stack_array(_ROWS, LANES)
 OUT_BOUND, OUT_S, OUT_SPHERE, OUT_ARMS = 0, 1, 2, 3
 
 
-def lanes_supported(model: tuple[np.ndarray, ...]) -> bool:
+def lanes_supported(model: KernelModel) -> bool:
     """Whether :func:`pair_along` serves a kernel model (few enough joints and coordinates)."""
-    return len(model[0]) <= MAX_JOINTS and model[9].shape[1] <= MAX_JOINTS
+    return len(model.axes) <= MAX_JOINTS and model.rates.shape[1] <= MAX_JOINTS
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
@@ -84,7 +85,7 @@ def _copy_rows(w: np.ndarray, dst: int, src: int, count: int) -> None:
 def _joint_rows(w: np.ndarray, j: int, model: Any, q_a: np.ndarray, q_b: np.ndarray) -> None:
     """World pose of joint frame j in every lane (its parent's rows ready): the parent's pose,
     the joint placement, then the rotation about the joint axis (it turns two columns)."""
-    axes, index_q, parents, pl = model[0], model[1], model[2], model[3]
+    axes, index_q, parents, pl = model.axes, model.index_q, model.parents, model.joint_placements
     a = axes[j]
     i1, i2 = (a + 1) % 3, (a + 2) % 3
     qa, dq = q_a[index_q[j]], q_b[index_q[j]] - q_a[index_q[j]]
@@ -114,11 +115,11 @@ def _joint_rows(w: np.ndarray, j: int, model: Any, q_a: np.ndarray, q_b: np.ndar
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
 def _primitive_rows(w: np.ndarray, out: int, g: int, model: Any) -> None:
     """World pose of primitive g in every lane -> rows out..out+11."""
-    pl = model[5]
+    pl = model.prim_placements
     p00, p01, p02, p03 = pl[g, 0, 0], pl[g, 0, 1], pl[g, 0, 2], pl[g, 0, 3]
     p10, p11, p12, p13 = pl[g, 1, 0], pl[g, 1, 1], pl[g, 1, 2], pl[g, 1, 3]
     p20, p21, p22, p23 = pl[g, 2, 0], pl[g, 2, 1], pl[g, 2, 2], pl[g, 2, 3]
-    _copy_rows(w, _P, 12 * model[4][g], 12)
+    _copy_rows(w, _P, 12 * model.prim_joints[g], 12)
     for i in range(LANES):
         for r in range(3):
             u0, u1, u2 = w[_P + 3 * r, i], w[_P + 3 * r + 1, i], w[_P + 3 * r + 2, i]
@@ -152,15 +153,21 @@ def _box_bounds(
     hb0, hb1, hb2 = half_b[b, 0], half_b[b, 1], half_b[b, 2]
     for i in range(LANES):
         w[_BOUND, i] = obb_gap(
-            w[_B + 9, i] - w[_A + 9, i],
-            w[_B + 10, i] - w[_A + 10, i],
-            w[_B + 11, i] - w[_A + 11, i],
-            (w[_A, i], w[_A + 1, i], w[_A + 2, i]),
-            (w[_A + 3, i], w[_A + 4, i], w[_A + 5, i]),
-            (w[_A + 6, i], w[_A + 7, i], w[_A + 8, i]),
-            (w[_B, i], w[_B + 1, i], w[_B + 2, i]),
-            (w[_B + 3, i], w[_B + 4, i], w[_B + 5, i]),
-            (w[_B + 6, i], w[_B + 7, i], w[_B + 8, i]),
+            (
+                w[_B + 9, i] - w[_A + 9, i],
+                w[_B + 10, i] - w[_A + 10, i],
+                w[_B + 11, i] - w[_A + 11, i],
+            ),
+            (
+                (w[_A, i], w[_A + 1, i], w[_A + 2, i]),
+                (w[_A + 3, i], w[_A + 4, i], w[_A + 5, i]),
+                (w[_A + 6, i], w[_A + 7, i], w[_A + 8, i]),
+            ),
+            (
+                (w[_B, i], w[_B + 1, i], w[_B + 2, i]),
+                (w[_B + 3, i], w[_B + 4, i], w[_B + 5, i]),
+                (w[_B + 6, i], w[_B + 7, i], w[_B + 8, i]),
+            ),
             (ha0, ha1, ha2),
             (hb0, hb1, hb2),
             rab,
@@ -169,15 +176,9 @@ def _box_bounds(
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
 def obb_gap(
-    t0: float,
-    t1: float,
-    t2: float,
-    ra0: tuple[float, float, float],
-    ra1: tuple[float, float, float],
-    ra2: tuple[float, float, float],
-    rb0: tuple[float, float, float],
-    rb1: tuple[float, float, float],
-    rb2: tuple[float, float, float],
+    t: tuple[float, float, float],
+    ra: tuple[tuple[float, float, float], ...],
+    rb: tuple[tuple[float, float, float], ...],
     ha: tuple[float, float, float],
     hb: tuple[float, float, float],
     rab: float,
@@ -185,10 +186,13 @@ def obb_gap(
     """Lower bound of the distance of two oriented boxes, in [m]: the larger of the sphere gap
     ``|t| - rab`` and the separating-axis gap over the 15 axes.
 
-    t: centre of B minus centre of A (world); ra0..ra2, rb0..rb2: rows of the boxes' rotations
+    t: centre of B minus centre of A (world); ra, rb: the three rows of the boxes' rotations
     (columns: the box axes); ha, hb: half sizes; rab: the sum of their bounding radii. No
     branch: a select leaves out near-parallel edge axes.
     """
+    t0, t1, t2 = t
+    ra0, ra1, ra2 = ra
+    rb0, rb1, rb2 = rb
     a00, a01, a02 = ra0
     a10, a11, a12 = ra1
     a20, a21, a22 = ra2
@@ -250,8 +254,12 @@ def _edge(best: float, along: float, radius_a: float, radius_b: float, m: float)
 def _sphere_bounds(w: np.ndarray, half: np.ndarray, a: int, model: Any, b: int) -> None:
     """Distance of box A (rows _A, half sizes half[a]) to sphere obstacle b, every lane -> row
     _BOUND (exact: point-box distance minus the radius)."""
-    c0, c1, c2 = model[11][b, 0], model[11][b, 1], model[11][b, 2]
-    radius = model[13][b, 0]
+    c0, c1, c2 = (
+        model.obstacle_centres[b, 0],
+        model.obstacle_centres[b, 1],
+        model.obstacle_centres[b, 2],
+    )
+    radius = model.obstacle_half[b, 0]
     ha = (half[a, 0], half[a, 1], half[a, 2])
     for i in range(LANES):
         d0, d1, d2 = c0 - w[_A + 9, i], c1 - w[_A + 10, i], c2 - w[_A + 11, i]
@@ -278,7 +286,13 @@ def _arm_row(w: np.ndarray, rows: int, extra: float) -> None:
 def _arm_rows(w: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
     """Lever arms of pair p about each configuration index, every lane -> out[OUT_ARMS + j]
     (as :func:`lynxplan.planning.edge_walk.lever_arms`)."""
-    axes, radius, owners, joints, pairs = model[0], model[7], model[15], model[16], model[8]
+    axes, radius, owners, joints, pairs = (
+        model.axes,
+        model.prim_radius,
+        model.owners,
+        model.joint_of_q,
+        model.pairs,
+    )
     for j in range(owners.shape[1]):
         g = owners[p, j]
         joint = joints[j]
@@ -304,7 +318,7 @@ def _pose_pair_rows(
 ) -> None:
     """Pair p's robot primitives posed at the LANES points s_i = out[OUT_S, i] of the edge from
     q_a to q_b (nq,): rows _A (and _B for a self pair)."""
-    pairs, prim_joints = model[8], model[4]
+    pairs, prim_joints = model.pairs, model.prim_joints
     for i in range(LANES):
         w[_S, i] = out[OUT_S, i]
     for r in range(12):  # the universe frame: identity
@@ -332,15 +346,15 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
     """
     w = _lane_rows()
     _pose_pair_rows(q_a, q_b, p, model, out, w)
-    a, b, is_self = model[8][p, 0], model[8][p, 1], model[8][p, 2]
-    half, radius = model[6], model[7]
+    a, b, is_self = model.pairs[p, 0], model.pairs[p, 1], model.pairs[p, 2]
+    half, radius = model.prim_half, model.prim_radius
     if is_self == 1:
         _box_bounds(w, half, a, half, b, radius[a] + radius[b])
-    elif model[10][b] == OBSTACLE_SPHERE:
+    elif model.obstacle_kinds[b] == OBSTACLE_SPHERE:
         _sphere_bounds(w, half, a, model, b)
     else:
-        _fixed_rows(w, _B, model[12], b)
-        _box_bounds(w, half, a, model[13], b, radius[a] + model[14][b])
+        _fixed_rows(w, _B, model.obstacle_poses, b)
+        _box_bounds(w, half, a, model.obstacle_half, b, radius[a] + model.obstacle_radius[b])
     for i in range(LANES):
         out[OUT_BOUND, i] = w[_BOUND, i]
     _arm_rows(w, p, model, out)
@@ -378,7 +392,13 @@ def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
     """The covering-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`) from
     rows _A (and _B), every lane -> row _BOUND, in [m]. Rows _P.._P+5 (the joint axis rows, free
     once the primitives are posed) hold sphere centres, row _T the other way round's distance."""
-    pairs, centres, counts, radii, half = model[8], model[17], model[18], model[19], model[6]
+    pairs, centres, counts, radii, half = (
+        model.pairs,
+        model.cover_centres,
+        model.cover_counts,
+        model.cover_radii,
+        model.prim_half,
+    )
     a, b = pairs[p, 0], pairs[p, 1]
     for i in range(LANES):
         w[_BOUND, i] = np.inf  # the smallest squared distance of a centre of a
@@ -394,19 +414,19 @@ def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
         for i in range(LANES):
             w[_BOUND, i] = max(math.sqrt(w[_BOUND, i]) - ra, math.sqrt(w[_T, i]) - rb)
         return
-    if model[10][b] == OBSTACLE_SPHERE:  # the centres' distance less both radii
+    if model.obstacle_kinds[b] == OBSTACLE_SPHERE:  # the centres' distance less both radii
         for r in range(3):
             for i in range(LANES):
-                w[_P + 3 + r, i] = model[12][b, r, 3]
+                w[_P + 3 + r, i] = model.obstacle_poses[b, r, 3]
         for m in range(counts[a]):
             _cover_rows(w, _A, centres[a, m], _P)
             _nearest_point(w)
-        other = radii[a] + model[13][b, 0]
+        other = radii[a] + model.obstacle_half[b, 0]
     else:
-        _fixed_rows(w, _B, model[12], b)
+        _fixed_rows(w, _B, model.obstacle_poses, b)
         for m in range(counts[a]):
             _cover_rows(w, _A, centres[a, m], _P)
-            _nearest_box(w, _B, model[13][b], _BOUND)
+            _nearest_box(w, _B, model.obstacle_half[b], _BOUND)
         other = radii[a]
     for i in range(LANES):
         w[_BOUND, i] = math.sqrt(w[_BOUND, i]) - other
@@ -466,9 +486,9 @@ def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
     obstacle), for all pairs of one configuration: the pairs' poses are gathered into rows of
     :data:`PAIR_BLOCK` pairs, then one branch-free loop computes every pair's bound.
     """
-    pairs, half, radius = model[8], model[6], model[7]
-    kinds, obstacle_poses = model[10], model[12]
-    obstacle_half, obstacle_radius = model[13], model[14]
+    pairs, half, radius = model.pairs, model.prim_half, model.prim_radius
+    kinds, obstacle_poses = model.obstacle_kinds, model.obstacle_poses
+    obstacle_half, obstacle_radius = model.obstacle_half, model.obstacle_radius
     # On the heap: measured a quarter faster than the same rows on the stack (stack_array).
     w = np.empty((_PAIR_ROWS, PAIR_BLOCK))
     count = pairs.shape[0]
@@ -497,15 +517,17 @@ def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
         for i in range(m):
             t0, t1, t2 = w[21, i] - w[9, i], w[22, i] - w[10, i], w[23, i] - w[11, i]
             box = obb_gap(
-                t0,
-                t1,
-                t2,
-                (w[0, i], w[1, i], w[2, i]),
-                (w[3, i], w[4, i], w[5, i]),
-                (w[6, i], w[7, i], w[8, i]),
-                (w[12, i], w[13, i], w[14, i]),
-                (w[15, i], w[16, i], w[17, i]),
-                (w[18, i], w[19, i], w[20, i]),
+                (t0, t1, t2),
+                (
+                    (w[0, i], w[1, i], w[2, i]),
+                    (w[3, i], w[4, i], w[5, i]),
+                    (w[6, i], w[7, i], w[8, i]),
+                ),
+                (
+                    (w[12, i], w[13, i], w[14, i]),
+                    (w[15, i], w[16, i], w[17, i]),
+                    (w[18, i], w[19, i], w[20, i]),
+                ),
                 (w[_HA, i], w[_HA + 1, i], w[_HA + 2, i]),
                 (w[_HB, i], w[_HB + 1, i], w[_HB + 2, i]),
                 w[_RAB, i],

@@ -143,58 +143,90 @@ def _sample(
             out[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
 
 
+@numba.njit(cache=True, inline="always")
+def _steer(q: np.ndarray, sample: np.ndarray, step: float, out: np.ndarray) -> bool:
+    """q (nq,) moved by at most ``step`` [rad] towards sample -> out; False when they coincide."""
+    distance = 0.0
+    for j in range(q.shape[0]):
+        distance += (sample[j] - q[j]) ** 2
+    distance = math.sqrt(distance)
+    if distance < 1e-12:
+        return False
+    fraction = min(1.0, step / distance)
+    for j in range(q.shape[0]):
+        out[j] = q[j] + fraction * (sample[j] - q[j])
+    return True
+
+
+class Trees(NamedTuple):
+    """The two trees of RRT-Connect, as the kernels take them (only the first counts[tree] rows
+    of a tree are read)."""
+
+    #: Nodes, (2, M, nq), in [rad].
+    nodes: np.ndarray
+    #: Parent of each node, (2, M) (a root's: -1).
+    parents: np.ndarray
+    #: The pairs' slacks at each node once known, (2, M, P), in [m].
+    slacks: np.ndarray
+    #: 1 where a node's slacks are known, (2, M).
+    known: np.ndarray
+    #: Nodes per tree, (2,).
+    counts: np.ndarray
+    #: Roots per tree, (2,).
+    roots: np.ndarray
+    #: [active tree, joint node of tree 0, joint node of tree 1, iterations done], (4,).
+    meta: np.ndarray
+
+    def grown(self, capacity: int) -> Trees:
+        """The same trees in arrays of ``capacity`` rows."""
+        nq, pairs = self.nodes.shape[2], self.slacks.shape[2]
+        rows = self.nodes.shape[1]
+        nodes, parents = np.empty((2, capacity, nq)), np.empty((2, capacity), dtype=np.int64)
+        slacks, known = np.empty((2, capacity, pairs)), np.zeros((2, capacity), dtype=np.int8)
+        nodes[:, :rows], parents[:, :rows] = self.nodes, self.parents
+        slacks[:, :rows], known[:, :rows] = self.slacks, self.known
+        return Trees(nodes, parents, slacks, known, self.counts, self.roots, self.meta)
+
+
+class Search(NamedTuple):
+    """The sampling of RRT-Connect: joint limits lower, upper (nq,), in [rad], the extension
+    step [rad] and the goal bias."""
+
+    lower: np.ndarray
+    upper: np.ndarray
+    step: float
+    goal_bias: float
+
+
 @njit_refcounted()  # returns a view: counted even when called from an uncounted kernel
-def _slacks(
-    nodes: np.ndarray,
-    slacks: np.ndarray,
-    known: np.ndarray,
-    tree: int,
-    index: int,
-    model: Any,
-    scratch: Any,
-    clearance: float,
-) -> np.ndarray:
-    """The pairs' slacks at a tree node (P,), computed on first use (known: slacks[tree, index]
-    is valid once the flag is set; a node's slacks never change)."""
-    if known[tree, index] == 0:
-        out = slacks[tree, index]
-        state_bounds(nodes[tree, index], model, scratch, out)
+def _slacks(trees: Trees, tree: int, index: int, check: Any) -> np.ndarray:
+    """The pairs' slacks at a tree node (P,), computed on first use (a node's slacks never
+    change)."""
+    model, scratch, clearance = check
+    if trees.known[tree, index] == 0:
+        out = trees.slacks[tree, index]
+        state_bounds(trees.nodes[tree, index], model, scratch, out)
         for p in range(out.shape[0]):
             out[p] -= clearance
-        known[tree, index] = 1
-    result: np.ndarray = slacks[tree, index]
+        trees.known[tree, index] = 1
+    result: np.ndarray = trees.slacks[tree, index]
     return result
 
 
 @numba.njit(cache=True)
 def _extends(
-    nodes: np.ndarray,
-    slacks: np.ndarray,
-    known: np.ndarray,
-    tree: int,
-    near: int,
-    new: np.ndarray,
-    fresh: np.ndarray,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    trees: Trees, tree: int, near: int, new: np.ndarray, fresh: np.ndarray, check: Any
 ) -> bool:
     """Whether the edge from node ``near`` of ``tree`` to ``new`` (nq,; its slacks: fresh
     (P,)) is certified whole (a blocked extension is usually blocked at its midpoint: that
     quick test first; its bounds then serve the walk)."""
-    if not point_is_clear(nodes[tree, near], new, 0.5, model, scratch, clearance, np.int64(0)):
+    model, scratch, clearance = check
+    base = trees.nodes[tree, near]
+    if not point_is_clear(base, new, 0.5, model, scratch, clearance, np.int64(0)):
         return False
-    start = _slacks(nodes, slacks, known, tree, near, model, scratch, clearance)
+    start = _slacks(trees, tree, near, check)
     reached = edge_fraction_from(
-        nodes[tree, near],
-        new,
-        start,
-        fresh,
-        np.int64(1),
-        model,
-        scratch,
-        clearance,
-        np.int64(ALL_JOINTS),
+        base, new, (start, fresh), np.int64(1), model, scratch, clearance, np.int64(ALL_JOINTS)
     )
     return bool(reached >= 1.0)
 
@@ -204,15 +236,12 @@ def _connect(
     base: np.ndarray,
     new: np.ndarray,
     pieces: int,
-    start: np.ndarray,
-    fresh: np.ndarray,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    slacks: tuple[np.ndarray, np.ndarray],
+    check: Any,
     ahead: np.ndarray,
 ) -> float:
-    """How far the straight edge from ``base`` to ``new`` (nq,; their slacks start and fresh
-    (P,)) is certified, as a fraction; only the multiples of 1 / pieces below it matter (the
+    """How far the straight edge from ``base`` to ``new`` (nq,; their slacks: slacks, two (P,)
+    arrays) is certified, as a fraction; only the multiples of 1 / pieces below it matter (the
     connection adds nodes there).
 
     The piece points are tested first (quick state tests, in order): the walk then covers the
@@ -220,6 +249,8 @@ def _connect(
     the passed points' bounds as its grid (up to :data:`GRID_POINTS` of them). ahead: (2, P)
     work rows.
     """
+    model, scratch, clearance = check
+    start = slacks[0]
     clear = pieces
     wide = pieces - 1 > GRID_POINTS  # more points than grid rows: no grid
     for k in range(1, pieces):
@@ -229,54 +260,39 @@ def _connect(
             clear = k - 1
             break
         if wide:
-            ahead[0] = scratch[18][0]
+            ahead[0] = scratch.grid[0]
     if clear == 0:
         return 0.0
     if clear == pieces:
         points = 0 if wide else pieces - 1
         return edge_fraction_from(
-            base, new, start, fresh, points, model, scratch, clearance, np.int64(ALL_JOINTS)
+            base, new, slacks, points, model, scratch, clearance, np.int64(ALL_JOINTS)
         )
     fraction = clear / pieces
     target = base + fraction * (new - base)
     for p in range(ahead.shape[1]):
-        ahead[1, p] = (ahead[0, p] if wide else scratch[18][clear - 1, p]) - clearance
+        ahead[1, p] = (ahead[0, p] if wide else scratch.grid[clear - 1, p]) - clearance
     # the grid points before the last one that passed, as fractions of the shorter edge
     points = 0 if wide else clear - 1
     for k in range(points):
-        scratch[20][k] = (k + 1) / clear
+        scratch.grid_at[k] = (k + 1) / clear
     reached = edge_fraction_from(
-        base, target, start, ahead[1], points, model, scratch, clearance, np.int64(ALL_JOINTS)
+        base, target, (start, ahead[1]), points, model, scratch, clearance, np.int64(ALL_JOINTS)
     )
     return fraction * reached if reached < 1.0 else fraction
 
 
 @numba.njit(cache=True)
 def rrt_connect_kernel(
-    lower: np.ndarray,
-    upper: np.ndarray,
-    step: float,
-    goal_bias: float,
-    model: Any,
-    scratch: Any,
-    clearance: float,
-    nodes: np.ndarray,
-    parents: np.ndarray,
-    counts: np.ndarray,
-    roots: np.ndarray,
-    state: np.ndarray,
-    meta: np.ndarray,
-    iterations: int,
-    slacks: np.ndarray,
-    known: np.ndarray,
+    search: Search, check: Any, trees: Trees, state: np.ndarray, iterations: int
 ) -> int:
     """Run up to ``iterations`` RRT-Connect iterations; returns RUNNING, SOLVED or NODE_LIMIT.
 
-    nodes: (2, M, nq); parents: (2, M); counts: (2,) nodes per tree; roots: (2,) root counts;
-    slacks: (2, M, P) the pairs' slacks at each node once known (known: (2, M), 1 when);
-    state: random state (1,) uint64; meta: [active tree, joint node tree 0, joint node tree 1,
-    iterations done] (int64).
+    state: random state (1,) uint64.
     """
+    model, scratch, clearance = check
+    lower, upper, step, goal_bias = search
+    nodes, parents, slacks, known, counts, roots, meta = trees
     nq = lower.shape[0]
     capacity = nodes.shape[1]
     sample = np.empty(nq)
@@ -291,20 +307,13 @@ def rrt_connect_kernel(
             return NODE_LIMIT
         _sample(lower, upper, goal_bias, nodes[b], roots[b], state, sample)
         near = _nearest(nodes[a], counts[a], sample)
-        distance = 0.0
-        for j in range(nq):
-            distance += (sample[j] - nodes[a, near, j]) ** 2
-        distance = math.sqrt(distance)
-        if distance < 1e-12:
+        if not _steer(nodes[a, near], sample, step, new):
             meta[0] = b
             continue
-        fraction = min(1.0, step / distance)
-        for j in range(nq):
-            new[j] = nodes[a, near, j] + fraction * (sample[j] - nodes[a, near, j])
         if not state_slacks(new, model, scratch, clearance, fresh):
             meta[0] = b
             continue
-        if not _extends(nodes, slacks, known, a, near, new, fresh, model, scratch, clearance):
+        if not _extends(trees, a, near, new, fresh, check):
             meta[0] = b
             continue
         added = _add(nodes, parents, counts, a, new, near)
@@ -317,9 +326,9 @@ def rrt_connect_kernel(
         for j in range(nq):
             length += (new[j] - base[j]) ** 2
         length = math.sqrt(length)
-        start = _slacks(nodes, slacks, known, b, other, model, scratch, clearance)
+        start = _slacks(trees, b, other, check)
         pieces = max(1, math.ceil(length / step))
-        reached = _connect(base, new, pieces, start, fresh, model, scratch, clearance, ahead)
+        reached = _connect(base, new, pieces, (start, fresh), check, ahead)
         parent = other
         for k in range(1, pieces + 1):
             s = k / pieces
@@ -391,13 +400,8 @@ def rrt_connect_begin(
     start: np.ndarray,
     goals: np.ndarray,
     capacity: int,
-    lower: np.ndarray,
-    upper: np.ndarray,
-    step: float,
-    goal_bias: float,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    search: Search,
+    check: Any,
     state: np.ndarray,
     iterations: int,
 ) -> tuple[Any, ...]:
@@ -406,15 +410,21 @@ def rrt_connect_begin(
     compiled calls).
 
     start: (nq,); goals: (K, nq), the roots of tree 1; capacity: rows of each tree. Returns
-    (status, path, goal index, nodes, parents, slacks, known, counts, roots, meta), the arrays
-    as :func:`rrt_connect_kernel` takes them; the path (N, nq) and its goal (a root of tree 1)
-    when the status is SOLVED, else an empty path and -1.
+    (status, path, goal index, trees); the path (N, nq) and its goal (a root of tree 1) when
+    the status is SOLVED, else an empty path and -1.
     """
+    model, scratch, clearance = check
     nq, count = start.shape[0], goals.shape[0]
-    nodes = np.empty((2, capacity, nq))
-    parents = np.empty((2, capacity), dtype=np.int64)  # rows written before they are read
-    slacks = np.empty((2, capacity, model[8].shape[0]))  # filled on first use (known)
-    known = np.zeros((2, capacity), dtype=np.int8)
+    trees = Trees(
+        np.empty((2, capacity, nq)),
+        np.empty((2, capacity), dtype=np.int64),  # rows written before they are read
+        np.empty((2, capacity, model.pairs.shape[0])),  # filled on first use (known)
+        np.zeros((2, capacity), dtype=np.int8),
+        np.array([1, count], dtype=np.int64),
+        np.array([1, count], dtype=np.int64),
+        np.array([0, -1, -1, 0], dtype=np.int64),
+    )
+    nodes, parents = trees.nodes, trees.parents
     for j in range(nq):
         nodes[0, 0, j] = start[j]
     parents[0, 0] = -1
@@ -422,71 +432,21 @@ def rrt_connect_begin(
         for j in range(nq):
             nodes[1, k, j] = goals[k, j]
         parents[1, k] = -1
-    counts = np.array([1, count], dtype=np.int64)
-    roots = counts.copy()
-    meta = np.array([0, -1, -1, 0], dtype=np.int64)
     k = straight_goal(start, goals, model, scratch, clearance)
     if k >= 0:  # the straight edge first: free space needs no tree
         path = np.empty((2, nq))
         for j in range(nq):
             path[0, j], path[1, j] = start[j], goals[k, j]
-        return SOLVED, path, k, nodes, parents, slacks, known, counts, roots, meta
-    status = rrt_connect_kernel(
-        lower,
-        upper,
-        step,
-        goal_bias,
-        model,
-        scratch,
-        clearance,
-        nodes,
-        parents,
-        counts,
-        roots,
-        state,
-        meta,
-        iterations,
-        slacks,
-        known,
-    )
+        return SOLVED, path, k, trees
+    status = rrt_connect_kernel(search, check, trees, state, iterations)
     if status == SOLVED:
-        path, goal = _solution(nodes, parents, meta)
-        return status, path, goal, nodes, parents, slacks, known, counts, roots, meta
-    return status, np.empty((0, nq)), -1, nodes, parents, slacks, known, counts, roots, meta
+        path, goal = _solution(nodes, parents, trees.meta)
+        return status, path, goal, trees
+    return status, np.empty((0, nq)), -1, trees
 
 
 #: Nodes each tree has room for at first; the arrays double when a kernel call might fill them.
 INITIAL_CAPACITY = 4096
-
-
-class _Trees(NamedTuple):
-    """The two trees' arrays (see :func:`rrt_connect_kernel`): nodes (2, M, nq), parents (2, M),
-    slacks (2, M, P), known (2, M); only the first counts[tree] rows of a tree are read."""
-
-    nodes: np.ndarray
-    parents: np.ndarray
-    slacks: np.ndarray
-    known: np.ndarray
-
-    @classmethod
-    def empty(cls, capacity: int, nq: int, pairs: int) -> _Trees:
-        # np.empty: rows are written before they are read (roots have parent -1), slacks are
-        # filled on first use (known)
-        return cls(
-            np.empty((2, capacity, nq)),
-            np.empty((2, capacity), dtype=np.int64),
-            np.empty((2, capacity, pairs)),
-            np.zeros((2, capacity), dtype=np.int8),
-        )
-
-    def grown(self, capacity: int) -> _Trees:
-        """The same trees in arrays of ``capacity`` rows."""
-        nq, pairs = self.nodes.shape[2], self.slacks.shape[2]
-        bigger = _Trees.empty(capacity, nq, pairs)
-        rows = self.nodes.shape[1]
-        for old, new in zip(self, bigger, strict=True):
-            new[:, :rows] = old
-        return bigger
 
 
 def _room(capacity: int, used: int, per_call: int, limit: int) -> int:
@@ -524,34 +484,31 @@ def rrt_connect(
     )
     capacity = _room(min(limit, INITIAL_CAPACITY), len(goals), per_call, limit)
     state = _rng.seed_state(seed)
-    model, scratch, clearance = checker.model, checker.scratch, checker.clearance
-    fixed = (lower, upper, settings.step, settings.goal_bias, model, scratch, clearance)
-    first = (start, goals, capacity, *fixed, state, CHUNK_ITERATIONS)
+    search = Search(lower, upper, float(settings.step), float(settings.goal_bias))
+    first = (start, goals, capacity, search, checker.data, state, CHUNK_ITERATIONS)
     # the first call in a process: compile (or load) the kernel outside the time limit
     began += compile_before_timing(rrt_connect_begin, first)
-    status, path, goal_index, *arrays = rrt_connect_begin(*first)
-    trees = _Trees(*arrays[:4])
-    counts, roots, meta = arrays[4:]
+    status, path, goal_index, trees = rrt_connect_begin(*first)
+    counts, meta = trees.counts, trees.meta
     if status == SOLVED:  # the straight edge to a goal, or found in the first iterations
         return RrtConnectResult(
             path, int(goal_index), int(counts.sum()), int(meta[3]), time.perf_counter() - began
         )
-    nodes, parents = trees.nodes, trees.parents
 
-    def arguments(trees: _Trees) -> tuple[Any, ...]:
-        nodes, parents, slacks, known = trees
-        return (*fixed, nodes, parents, counts, roots, state, meta, CHUNK_ITERATIONS, slacks, known)
+    def arguments(trees: Trees) -> tuple[Any, ...]:
+        return (search, checker.data, trees, state, CHUNK_ITERATIONS)
 
     began += compile_before_timing(rrt_connect_kernel, arguments(trees))
-    began += compile_before_timing(_solution, (nodes, parents, meta))
+    began += compile_before_timing(_solution, (trees.nodes, trees.parents, meta))
     while status != SOLVED:
         elapsed = time.perf_counter() - began
-        if status == NODE_LIMIT and nodes.shape[1] >= limit:
+        rows = trees.nodes.shape[1]
+        if status == NODE_LIMIT and rows >= limit:
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"node limit {settings.max_nodes} reached"
             )
         if status == NODE_LIMIT:  # not the budget: grow, go on
-            trees = trees.grown(min(limit, 2 * nodes.shape[1]))
+            trees = trees.grown(min(limit, 2 * rows))
         elif elapsed >= time_limit:
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
@@ -559,9 +516,8 @@ def rrt_connect(
         capacity = _room(trees.nodes.shape[1], int(counts.max()), per_call, limit)
         if capacity > trees.nodes.shape[1]:
             trees = trees.grown(capacity)
-        nodes, parents = trees.nodes, trees.parents
         status = rrt_connect_kernel(*arguments(trees))
-    path, goal_index = _solution(nodes, parents, meta)
+    path, goal_index = _solution(trees.nodes, trees.parents, meta)
     return RrtConnectResult(
         path, goal_index, int(counts.sum()), int(meta[3]), time.perf_counter() - began
     )

@@ -122,16 +122,11 @@ def _distance(a: np.ndarray, b: np.ndarray) -> float:
 
 @njit_refcounted()  # returns a view: counted even when called from an uncounted kernel
 def _slacks_at(
-    points: np.ndarray,
-    k: int,
-    slacks: np.ndarray,
-    known: np.ndarray,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    points: np.ndarray, k: int, slacks: np.ndarray, known: np.ndarray, check: Any
 ) -> np.ndarray:
     """Every pair's slack at points[k] (P,), in [m], computed on first use (slacks: (N, P),
     known: (N,) flags)."""
+    model, scratch, clearance = check
     if not known[k]:
         state_bounds(points[k], model, scratch, slacks[k])
         for p in range(slacks.shape[1]):
@@ -142,11 +137,12 @@ def _slacks_at(
 
 
 @numba.njit(cache=True)
-def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: float) -> int:
+def _greedy(path: np.ndarray, count: int, check: Any) -> int:
     """Vertex shortcuts, farthest first: from each kept waypoint, the farthest later waypoint
     it sees directly becomes the next one (in place on path[:count]); returns the new count.
     Each waypoint's pair slacks are computed once (the edge walks start and end there)."""
-    slacks = np.empty((count, model[8].shape[0]))
+    model, scratch, clearance = check
+    slacks = np.empty((count, model.pairs.shape[0]))
     known = np.zeros(count, dtype=np.bool_)
     kept = 0
     i = np.int64(0)  # not a literal 0: numba would compile _slacks_at for it as well
@@ -154,13 +150,12 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
         j = count - 1
         while j > i + 1:
             if probes_are_clear(path[i], path[j], model, scratch, clearance):
-                start = _slacks_at(path, i, slacks, known, model, scratch, clearance)
-                end = _slacks_at(path, j, slacks, known, model, scratch, clearance)
+                start = _slacks_at(path, i, slacks, known, check)
+                end = _slacks_at(path, j, slacks, known, check)
                 reached = edge_fraction_from(
                     path[i],
                     path[j],
-                    start,
-                    end,
+                    (start, end),
                     np.int64(PROBES),
                     model,
                     scratch,
@@ -178,9 +173,7 @@ def _greedy(path: np.ndarray, count: int, model: Any, scratch: Any, clearance: f
 
 
 @numba.njit(cache=True)
-def _segments_free(
-    points: np.ndarray, size: int, model: Any, scratch: Any, clearance: float, moved: int
-) -> bool:
+def _segments_free(points: np.ndarray, size: int, check: Any, moved: int) -> bool:
     """Whether every straight edge between consecutive rows of points[:size] is certified
     (quick midpoint tests of all edges first: a blocked edge is usually blocked there; their
     bounds then serve the walks, and so do the points' slacks, each computed once).
@@ -188,23 +181,24 @@ def _segments_free(
     moved: the joints (bit j: joint j) in which the edges differ from pieces of certified
     edges (the path's, before a partial cut or a goal switch changed those joints), or
     ALL_JOINTS (:func:`lynxplan.planning.edge_walk.edge_walk`)."""
-    pairs = model[8].shape[0]
+    model, scratch, clearance = check
+    pairs = model.pairs.shape[0]
     middle = np.empty((max(size - 1, 0), pairs))
     for k in range(size - 1):
         if not point_is_clear(
             points[k], points[k + 1], 0.5, model, scratch, clearance, np.int64(0)
         ):
             return False
-        middle[k] = scratch[18][0]
+        middle[k] = scratch.grid[0]
     slacks = np.empty((size, pairs))
     known = np.zeros(size, dtype=np.bool_)
     for k in range(size - 1):
-        start = _slacks_at(points, k, slacks, known, model, scratch, clearance)
-        end = _slacks_at(points, k + 1, slacks, known, model, scratch, clearance)
-        scratch[18][0] = middle[k]
-        scratch[20][0] = 0.5
+        start = _slacks_at(points, k, slacks, known, check)
+        end = _slacks_at(points, k + 1, slacks, known, check)
+        scratch.grid[0] = middle[k]
+        scratch.grid_at[0] = 0.5
         reached = edge_fraction_from(
-            points[k], points[k + 1], start, end, np.int64(1), model, scratch, clearance, moved
+            points[k], points[k + 1], (start, end), np.int64(1), model, scratch, clearance, moved
         )
         if reached < 1.0:
             return False
@@ -243,21 +237,14 @@ def _splice(
 
 @njit_no_refcount()
 def _full(
-    path: np.ndarray,
-    count: int,
-    cumulative: np.ndarray,
-    u1: float,
-    u2: float,
-    model: Any,
-    scratch: Any,
-    clearance: float,
-    work: np.ndarray,
-    piece: np.ndarray,
-    gain: float,
+    path: np.ndarray, count: int, cut: tuple[float, float, float], check: Any, rows: Any
 ) -> int:
-    """Full shortcut: the straight edge between the points at arc lengths u1 < u2 replaces the
-    path between them when it shortens the path by at least ``gain`` [rad] and is certified (in
-    place); returns the new count, or 0 when nothing changed."""
+    """Full shortcut: the straight edge between the points at arc lengths u1 < u2 (cut = (u1,
+    u2, gain)) replaces the path between them when it shortens the path by at least ``gain``
+    [rad] and is certified (in place); returns the new count, or 0 when nothing changed."""
+    model, scratch, clearance = check
+    u1, u2, gain = cut
+    cumulative, work, piece = rows
     first, second = piece[0], piece[1]
     i1 = _point_at(path, cumulative, count, u1, first)
     i2 = _point_at(path, cumulative, count, u2, second)
@@ -299,21 +286,17 @@ def _wandering_joint(path: np.ndarray, count: int, r: float) -> int:
 def _partial(
     path: np.ndarray,
     count: int,
-    cumulative: np.ndarray,
-    u1: float,
-    u2: float,
+    cut: tuple[float, float, float],
     joint: int,
-    model: Any,
-    scratch: Any,
-    clearance: float,
-    work: np.ndarray,
-    piece: np.ndarray,
-    gain: float,
+    check: Any,
+    rows: Any,
 ) -> int:
     """Partial shortcut of one joint (Geraerts & Overmars 2007): between the points at arc
-    lengths u1 < u2, that joint moves linearly in the arc length while the others keep their
-    motion. Applied in place when it shortens the path by at least ``gain`` [rad] and every new
-    edge is certified; returns the new count, or 0 when nothing changed."""
+    lengths u1 < u2 (cut = (u1, u2, gain)), that joint moves linearly in the arc length while the
+    others keep their motion. Applied in place when it shortens the path by at least ``gain``
+    [rad] and every new edge is certified; returns the new count, or 0 when nothing changed."""
+    u1, u2, gain = cut
+    cumulative, work, piece = rows
     first, second = piece[0], piece[1]
     i1 = _point_at(path, cumulative, count, u1, first)
     i2 = _point_at(path, cumulative, count, u2, second)
@@ -337,23 +320,13 @@ def _partial(
     if length >= (u2 - u1) - gain:
         return 0
     # In the other joints, each new edge runs along a piece of an edge of the path.
-    if not _segments_free(points, size, model, scratch, clearance, joint_bit(joint)):
+    if not _segments_free(points, size, check, joint_bit(joint)):
         return 0
     return _splice(path, count, i1, i2, points, size, work)
 
 
 @numba.njit(cache=True)
-def _flatten(
-    path: np.ndarray,
-    count: int,
-    cumulative: np.ndarray,
-    levels: int,
-    model: Any,
-    scratch: Any,
-    clearance: float,
-    work: np.ndarray,
-    piece: np.ndarray,
-) -> int:
+def _flatten(path: np.ndarray, count: int, levels: int, check: Any, rows: Any) -> int:
     """Partial shortcuts of each joint over the whole path, then over its halves, ... (``levels``
     levels: 2^level equal parts of the arc length at level ``level``), in place on
     path[:count]; returns the new count. A joint that wanders over the whole path (a wrist roll
@@ -361,6 +334,7 @@ def _flatten(
     go in order of their motion beyond their net displacement, largest first (the largest gains
     first; the joints tried later then move less)."""
     nq = path.shape[1]
+    cumulative = rows[0]
     excess = np.empty(nq)  # each joint's motion beyond its net displacement: largest first
     for j in range(nq):
         excess[j] = -abs(path[count - 1, j] - path[0, j])
@@ -377,20 +351,12 @@ def _flatten(
                 for k in range(1, count):
                     cumulative[k] = cumulative[k - 1] + _distance(path[k - 1], path[k])
                 total = cumulative[count - 1]
-                size = _partial(
-                    path,
-                    count,
-                    cumulative,
+                cut = (
                     total * part / parts,
                     total * (part + 1) / parts,
-                    joint,
-                    model,
-                    scratch,
-                    clearance,
-                    work,
-                    piece,
                     max(MIN_GAIN, FLATTEN_MIN_GAIN * total),
                 )
+                size = _partial(path, count, cut, joint, check, rows)
                 if size > 0:
                     count = size
     return count
@@ -403,9 +369,7 @@ def _switch_goal(
     goals: np.ndarray,
     current: int,
     bounds: np.ndarray,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    check: Any,
     piece: np.ndarray,
 ) -> int:
     """Move the end of path[:count] to another goal configuration when that shortens it: the
@@ -446,51 +410,60 @@ def _switch_goal(
             for j in range(nq):
                 if piece[k, j] != path[k, j]:
                     moved |= joint_bit(j)
-        if _segments_free(piece, count, model, scratch, clearance, moved):
+        if _segments_free(piece, count, check, moved):
             for k in range(count):
                 path[k] = piece[k]
             return int(g)
     return current
 
 
+class ShortcutSettings(NamedTuple):
+    """The passes of :func:`shortcut_to_goals`, as the kernel takes them."""
+
+    #: Random cut attempts, at most.
+    iterations: int
+    #: The random cuts stop after this many attempts in a row that changed nothing.
+    patience: int
+    #: Greedy vertex shortcuts first.
+    greedy: bool
+    #: Fraction of the random attempts that are partial (one-joint) cuts.
+    partial: float
+    #: Levels of the one-joint straightening.
+    levels: int
+
+
 @numba.njit(cache=True)
 def shortcut_kernel(
     path: np.ndarray,
     count: int,
-    iterations: int,
+    settings: ShortcutSettings,
     state: np.ndarray,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    check: Any,
+    ends: tuple[np.ndarray, np.ndarray, np.ndarray],
     work: np.ndarray,
-    patience: int,
-    greedy: bool,
-    partial: float,
-    goals: np.ndarray,
-    goal: np.ndarray,
-    bounds: np.ndarray,
-    levels: int,
 ) -> int:
-    """Greedy vertex shortcuts (if ``greedy``), goal switch, one-joint straightening over
-    ``levels`` levels, random full and partial cuts (a fraction ``partial`` of the attempts)
-    then greedy vertex shortcuts, in place on path[:count]; returns the new count.
+    """Greedy vertex shortcuts (if ``settings.greedy``), goal switch, one-joint straightening
+    over ``settings.levels`` levels, random full and partial cuts (a fraction
+    ``settings.partial`` of the attempts) then greedy vertex shortcuts, in place on
+    path[:count]; returns the new count.
 
     path: (capacity, nq); a cut adds at most two rows, and none is made once the capacity is
     reached (count + 2 * (iterations + nq * (2^levels - 1)) suffices); work: same shape. The
-    cuts stop early after ``patience`` attempts in a row that changed nothing. goals: (K, nq) goal
-    configurations; goal: (1,) the index of the one path[count - 1] is, updated; bounds:
-    (2, nq) joint limits, in [rad].
+    cuts stop early after ``settings.patience`` attempts in a row that changed nothing. ends:
+    goals (K, nq) goal configurations; goal (1,) the index of the one path[count - 1] is,
+    updated; bounds (2, nq) joint limits, in [rad].
     """
+    iterations, patience, greedy, partial, levels = settings
+    goals, goal, bounds = ends
     nq = path.shape[1]
     cumulative = np.empty(path.shape[0])
     piece = np.empty((path.shape[0] + 2, nq))
+    rows = (cumulative, work, piece)
     if greedy:
-        count = _greedy(path, count, model, scratch, clearance)
+        count = _greedy(path, count, check)
     if goals.shape[0] > 1 and count >= 2:
-        goal[0] = _switch_goal(
-            path, count, goals, goal[0], bounds, model, scratch, clearance, piece
-        )
-    count = _flatten(path, count, cumulative, levels, model, scratch, clearance, work, piece)
+        goal[0] = _switch_goal(path, count, goals, goal[0], bounds, check, piece)
+    count = _flatten(path, count, levels, check, rows)
     idle = 0
     for _ in range(iterations):
         if count < 3 or idle >= patience:
@@ -508,28 +481,14 @@ def shortcut_kernel(
             joint = _wandering_joint(path, count, _rng.uniform(state))
             if joint < 0:
                 continue
-            size = _partial(
-                path,
-                count,
-                cumulative,
-                u1,
-                u2,
-                joint,
-                model,
-                scratch,
-                clearance,
-                work,
-                piece,
-                MIN_GAIN,
-            )
+            size = _partial(path, count, (u1, u2, MIN_GAIN), joint, check, rows)
             if size > 0:
                 count, idle = size, 0
             continue
-        gain = FULL_MIN_GAIN * total
-        size = _full(path, count, cumulative, u1, u2, model, scratch, clearance, work, piece, gain)
+        size = _full(path, count, (u1, u2, FULL_MIN_GAIN * total), check, rows)
         if size > 0:
             count, idle = size, 0
-    return _greedy(path, count, model, scratch, clearance)
+    return _greedy(path, count, check)
 
 
 @numba.njit(cache=True)
@@ -632,17 +591,10 @@ def shortcut_to_goals(
         kernel_input(np.asarray(path, dtype=float)),
         kernel_input(np.asarray(goals, dtype=float)),
         int(goal_index),
-        kernel_input(np.asarray(lower, dtype=float)),
-        kernel_input(np.asarray(upper, dtype=float)),
+        kernel_input(np.array([lower, upper], dtype=float)),
         state,
-        iterations,
-        patience,
-        greedy,
-        partial,
-        levels,
-        checker.model,
-        checker.scratch,
-        checker.clearance,
+        ShortcutSettings(int(iterations), int(patience), bool(greedy), float(partial), int(levels)),
+        checker.data,
     )
     return ShortcutResult(shortened, int(goal))
 
@@ -652,50 +604,25 @@ def shortcut_path(
     path: np.ndarray,
     goals: np.ndarray,
     goal_index: int,
-    lower: np.ndarray,
-    upper: np.ndarray,
+    bounds: np.ndarray,
     state: np.ndarray,
-    iterations: int,
-    patience: int,
-    greedy: bool,
-    partial: float,
-    levels: int,
-    model: Any,
-    scratch: Any,
-    clearance: float,
+    settings: ShortcutSettings,
+    check: Any,
 ) -> tuple[np.ndarray, int]:
     """:func:`shortcut_to_goals` in one compiled call (the Python steps around the kernel
     cost more than their work between compiled calls): the path (N, nq) without its collinear
     waypoints (RRT-Connect adds one every step along a connection), copied into work arrays
     with room for every cut, :func:`shortcut_kernel`; returns the new path (M, nq) and the index
-    of the goal it ends at. state: random state (1,) uint64, advanced."""
+    of the goal it ends at. bounds: joint limits (2, nq), in [rad]; state: random state (1,)
+    uint64, advanced."""
     keep = np.empty(path.shape[0], dtype=np.int64)
     count = _collinear_kernel(path, keep)
     nq = path.shape[1]
-    capacity = count + 2 * (iterations + nq * (2**levels - 1)) + 2
+    capacity = count + 2 * (settings.iterations + nq * (2**settings.levels - 1)) + 2
     buffer = np.zeros((capacity, nq))
     for k in range(count):
         copy_row(buffer, k, path, keep[k])
     work = np.zeros_like(buffer)
     goal = np.full(1, goal_index, dtype=np.int64)
-    bounds = np.empty((2, nq))
-    for j in range(nq):
-        bounds[0, j], bounds[1, j] = lower[j], upper[j]
-    count = shortcut_kernel(
-        buffer,
-        count,
-        iterations,
-        state,
-        model,
-        scratch,
-        clearance,
-        work,
-        patience,
-        greedy,
-        partial,
-        goals,
-        goal,
-        bounds,
-        levels,
-    )
+    count = shortcut_kernel(buffer, count, settings, state, check, (goals, goal, bounds), work)
     return buffer[:count].copy(), int(goal[0])

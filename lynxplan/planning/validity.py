@@ -56,7 +56,7 @@ from lynxplan.planning.bounds import (
     state_clearance,
 )
 from lynxplan.planning.edge_walk import edge_fraction
-from lynxplan.planning.kernel_model import kernel_model, make_scratch, planner_pairs
+from lynxplan.planning.kernel_model import CheckData, kernel_model, make_scratch, planner_pairs
 
 #: The kernels live in :mod:`lynxplan.planning.bounds` (below the edge walk, which uses them);
 #: they are imported from here too.
@@ -103,6 +103,8 @@ class ValidityChecker:
         self.pair_names = tuple(names)
         self.model = kernel_model(world, pairs)
         self.scratch = make_scratch(self.model)
+        #: The model, scratch and clearance, as the planner's kernels take them.
+        self.data = CheckData(self.model, self.scratch, self.clearance)
 
     def pair_bounds(self, q: np.ndarray) -> np.ndarray:
         """Lower bound of every pair's distance. q: shape (nq,), in [rad] -> (P,), in [m]."""

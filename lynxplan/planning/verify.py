@@ -171,7 +171,9 @@ class ExactVerifier:
         bounds (one compiled call for all rows) until a positive bound reaches the best exact
         distance (a bound <= 0 proves nothing: such a pair is always queried); usually one or
         two coal queries per configuration instead of one per pair."""
-        config = kernel_input(np.reshape(np.asarray(q, dtype=float), (-1, self.model[9].shape[1])))
+        config = kernel_input(
+            np.reshape(np.asarray(q, dtype=float), (-1, self.model.rates.shape[1]))
+        )
         bounds = np.empty((len(config), len(self.pairs)))
         poses = np.empty((len(config), len(self.world.links), 4, 4))
         waypoint_bounds(config, self.model, self.scratch, bounds, poses)

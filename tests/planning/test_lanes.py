@@ -51,10 +51,10 @@ def test_all_pair_bounds_match_the_scalar_bounds_and_stay_below_coal(
     for _ in range(SAMPLES):
         q = rng.uniform(arm.limits.lower, arm.limits.upper)
         primitive_poses(q, model, scratch)
-        all_pair_bounds(model, scratch[3], out)
+        all_pair_bounds(model, scratch.prim_poses, out)
         scalar = np.array([pair_bound(p, model, scratch) for p in range(len(out))])
         assert (out >= scalar - ROUNDING).all()  # every axis of the scalar test, and more
-        exact = _exact(verifier, checker, scratch[3])
+        exact = _exact(verifier, checker, scratch.prim_poses)
         apart = exact > 0
         assert (out[apart] <= exact[apart] + BOUND_TOLERANCE).all(), q.tolist()
         assert (out[~apart] <= 0.0).all(), q.tolist()
@@ -88,13 +88,13 @@ def test_pair_and_spheres_along_match_single_steps_and_stay_below_coal(
         for i in range(LANES):
             s = out[OUT_S, i]
             pose_pair_at(q_a, q_b, s, p, model, scratch, 1)
-            np.testing.assert_allclose(out[OUT_ARMS:, i], scratch[13][1], atol=ROUNDING)
+            np.testing.assert_allclose(out[OUT_ARMS:, i], scratch.arms[1], atol=ROUNDING)
             assert out[OUT_BOUND, i] >= pair_bound(p, model, scratch) - ROUNDING
             assert abs(out[OUT_SPHERE, i] - sphere_gap(p, model, scratch)) <= ROUNDING
             primitive_poses(q_a + s * (q_b - q_a), model, scratch)
-            all_pair_bounds(model, scratch[3], full)
+            all_pair_bounds(model, scratch.prim_poses, full)
             assert abs(out[OUT_BOUND, i] - full[p]) <= ROUNDING
-            exact = _exact(verifier, checker, scratch[3])[p]
+            exact = _exact(verifier, checker, scratch.prim_poses)[p]
             if exact > 0:
                 assert out[OUT_BOUND, i] <= exact + BOUND_TOLERANCE
                 assert out[OUT_SPHERE, i] <= exact + BOUND_TOLERANCE

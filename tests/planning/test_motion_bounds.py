@@ -27,7 +27,7 @@ def checker(arm: Arm) -> ValidityChecker:
 
 def _corners(checker: ValidityChecker, poses: np.ndarray, g: int) -> np.ndarray:
     """Corners of primitive g's box at primitive poses (N, G, 4, 4) -> (N, 8, 3), in [m]."""
-    half = checker.model[6][g]
+    half = checker.model.prim_half[g]
     signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], float)
     local = signs * half
     return np.einsum("nij,kj->nki", poses[:, g, :3, :3], local) + poses[:, g, None, :3, 3]
@@ -37,16 +37,16 @@ def _moving_corners(checker: ValidityChecker, p: int, q: np.ndarray) -> np.ndarr
     """Corners of the moving primitive of pair p along q (N, nq), in the frame of the pair's
     other side (world for an obstacle); None for the pairs this test does not model (both
     sides moving, or a fixed primitive: its symmetry is tested elsewhere)."""
-    a, b, is_self = checker.model[8][p]
-    owners = checker.model[15][p]
-    poses = np.empty((len(q), len(checker.model[4]), 4, 4))
+    a, b, is_self = checker.model.pairs[p]
+    owners = checker.model.owners[p]
+    poses = np.empty((len(q), len(checker.model.prim_joints), 4, 4))
     for n, config in enumerate(q):
         primitive_poses(config, checker.model, checker.scratch)
-        poses[n] = checker.scratch[3]
+        poses[n] = checker.scratch.prim_poses
     corners = _corners(checker, poses, a)
     if not is_self:
         return corners
-    if (owners == b).any() or checker.model[4][b] == 0:
+    if (owners == b).any() or checker.model.prim_joints[b] == 0:
         return None
     inverse = np.linalg.inv(poses[:, b])
     return np.einsum("nij,nkj->nki", inverse[:, :3, :3], corners) + inverse[:, None, :3, 3]
@@ -54,7 +54,14 @@ def _moving_corners(checker: ValidityChecker, p: int, q: np.ndarray) -> np.ndarr
 
 def _arms_at(checker: ValidityChecker, p: int, q: np.ndarray, side: int) -> None:
     primitive_poses(q, checker.model, checker.scratch)
-    lever_arms(p, checker.scratch[0], checker.scratch[3], checker.model, checker.scratch[13], side)
+    lever_arms(
+        p,
+        checker.scratch.joint_poses,
+        checker.scratch.prim_poses,
+        checker.model,
+        checker.scratch.arms,
+        side,
+    )
 
 
 def test_span_and_step_bounds_cover_the_real_motion(arm: Arm, checker: ValidityChecker) -> None:
@@ -64,7 +71,7 @@ def test_span_and_step_bounds_cover_the_real_motion(arm: Arm, checker: ValidityC
     for _ in range(EDGES):
         q_a = rng.uniform(lower, upper)
         q_b = np.clip(q_a + rng.normal(scale=0.6, size=q_a.size), lower, upper)
-        checker.scratch[14][:] = np.abs(q_b - q_a)
+        checker.scratch.dq[:] = np.abs(q_b - q_a)
         s = rng.uniform(0.0, 0.8)
         t = s + rng.uniform(0.02, 0.2)  # the walks' steps are short
         u = np.linspace(s, t, SAMPLES)
@@ -82,11 +89,11 @@ def test_span_and_step_bounds_cover_the_real_motion(arm: Arm, checker: ValidityC
             assert (there + back).max() <= bound + TOLERANCE, (p, s, t)
             # One-sided: within reach_step(slack) of s, nothing moves more than slack.
             slack = 0.25 * max(bound, 1e-6)
-            step = reach_step(slack, p, checker.scratch[13], 0, checker.model, checker.scratch)
+            step = reach_step(slack, p, checker.scratch.arms, 0, checker.model, checker.scratch)
             inside = u - s <= step
             assert there[inside].max(initial=0.0) <= slack + TOLERANCE, (p, s, step)
             tested += 1
-            static = float(checker.model[9][p] @ checker.scratch[14]) * (t - s)
+            static = float(checker.model.rates[p] @ checker.scratch.dq) * (t - s)
             tight += bound < 0.8 * static
     assert tested > 200
     assert tight > tested // 5  # the lever arms are tighter than the static reach
@@ -107,8 +114,8 @@ def test_a_pair_with_a_zero_rate_about_a_joint_keeps_its_exact_distance_when_it_
             zip(world.pair_link, world.pair_other, world.pair_is_self, strict=True)
         )
     }
-    rows = [world_rows[tuple(int(v) for v in row)] for row in checker.model[8]]
-    rates = checker.model[9]
+    rows = [world_rows[tuple(int(v) for v in row)] for row in checker.model.pairs]
+    rates = checker.model.rates
     rng = np.random.default_rng(11)
     lower, upper = np.asarray(arm.limits.lower), np.asarray(arm.limits.upper)
     changed = np.zeros_like(rates, dtype=bool)

@@ -194,7 +194,7 @@ def test_covering_sphere_gaps_are_lower_bounds_of_the_exact_distances(arm: Arm) 
     for _ in range(200):
         q = rng.uniform(lower, upper)
         primitive_poses(q, model, scratch)
-        poses = scratch[3].copy()
+        poses = scratch.prim_poses.copy()
         for p in range(len(verifier.pairs)):
             gap = sphere_gap(p, model, scratch)
             exact = verifier.exact(poses, p)
