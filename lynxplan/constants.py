@@ -136,3 +136,36 @@ EXACT_ROOT_STEP = 1e-9
 
 #: The reach boundary of an exact branch is located to this [rad].
 BOUNDARY_TOLERANCE = 1e-7
+
+# -- the vectorised full-pose solver (``robots/ik/pose_block`` and its ``block_*`` modules) --
+
+#: A candidate whose final position [m] or orientation [rad] error is above this and has
+#: stopped falling (at least BLOCK_STALLED times the error before the last step) is not an
+#: exact branch: the orientation is out of reach on that flip, and the steps end at the residual
+#: of the nearest orientation (~1e-4), as the scalar polish does, which rejects it too. A
+#: candidate still falling there, or next to a fold of the elbow (where Newton's steps converge
+#: only linearly: the roots are close), is finished by the scalar polish.
+BLOCK_NOT_A_BRANCH = 1e-6
+#: ... (the ratio to the error before the last step) [1].
+BLOCK_STALLED = 0.5
+#: Next to a fold: |cos| of the elbow angle within this of 1 (an elbow ~0.045 rad from straight).
+BLOCK_FOLD_BAND = 1e-3
+#: A candidate whose step is this ill-conditioned (``newton_ldl``: smallest over largest LDL^T
+#: pivot of J^T J; ``newton_parallel``: its two measures) is finished by the scalar polish [1].
+BLOCK_ILL_CONDITIONED = 1e-8
+#: Pitch axes parallel within this [rad] (and either sign) take ``newton_parallel``'s steps:
+#: the same Gauss-Newton step to ~1e-10 of its size, by the family's structure.
+BLOCK_PARALLEL_PITCHES = 1e-10
+#: The polish's steps [rad] up to which the sines and cosines of the new angles follow exactly
+#: (to rounding) from those of the old by their Taylor series (``turn``); a candidate with a
+#: larger step is finished by the scalar polish.
+BLOCK_TAYLOR_STEP = 1e-3
+#: ... and up to which a candidate may be found not to be a branch: there the sines and cosines
+#: are within FAR_STEP^6 / 720 (1.4e-9) of the exact ones, far below BLOCK_NOT_A_BRANCH [rad].
+BLOCK_FAR_STEP = 0.1
+#: The margin [m per m of distance from the yaw axis] of the test that leaves a flip out
+#: (``screen_flips``): ~1e5 times the rounding of the yaws it bounds.
+BLOCK_OTHER_MARGIN = 1e-9
+#: Both flips are computed where the approach's component along the yaw axis [1] or the
+#: target's distance from it [m] is within this of 0 (the pitch sum or yaw may be degenerate).
+BLOCK_OTHER_DEGENERATE = 1e-9

@@ -122,27 +122,27 @@ def test_block_kernel_equals_scalar_kernel_on_random_family_urdfs(tmp_path: Path
 
 def test_parallel_pitch_steps_are_the_normal_equations_steps(tmp_path: Path) -> None:
     """Where the pitch axes are parallel (of either sign) the polish takes its Gauss-Newton
-    steps from the family's structure (``_newton_parallel``): the same steps as the normal
-    equations' (``_newton_ldl``), on random family URDFs with the roll axis tilted (a model
+    steps from the family's structure (``newton_parallel``): the same steps as the normal
+    equations' (``newton_ldl``), on random family URDFs with the roll axis tilted (a model
     only close to the family whose pitch axes stay parallel, as the SO-101) and on the SO-101,
     from starts ~1e-5 off random configurations; the block kernel, which then takes them,
     still equals the scalar one. A tilted pitch axis takes the normal equations."""
     import numba
 
-    from lynxplan.robots.ik.pose_block import (
-        _chain_tuple,
-        _newton_ldl,
-        _newton_parallel,
-        _offsets,
-        _parallel_pitches,
+    from lynxplan.robots.ik.block_layout import chain_tuple
+    from lynxplan.robots.ik.block_newton import (
+        newton_ldl,
+        newton_parallel,
+        offsets,
+        parallel_pitches,
     )
 
     @numba.njit(cache=False)
     def steps(ch, t, q):  # type: ignore[no-untyped-def]
         s, c = np.sin(q), np.cos(q)
-        sn, cs = _offsets(ch, (s[0], s[1], s[2], s[3], s[4]), (c[0], c[1], c[2], c[3], c[4]))
+        sn, cs = offsets(ch, (s[0], s[1], s[2], s[3], s[4]), (c[0], c[1], c[2], c[3], c[4]))
         qq = (q[0], q[1], q[2], q[3], q[4])
-        return _newton_parallel(ch, t, qq, sn, cs), _newton_ldl(ch, t, qq, sn, cs)
+        return newton_parallel(ch, t, qq, sn, cs), newton_ldl(ch, t, qq, sn, cs)
 
     rng = np.random.default_rng(21)
     worst: list[float] = []
@@ -150,8 +150,8 @@ def test_parallel_pitch_steps_are_the_normal_equations_steps(tmp_path: Path) -> 
     robots = [load_robot(tilted_urdf(path, joint="j5"), tool="tool") for path in paths]
     for robot in [*robots, load_robot("so101")]:
         assert robot.family is not None and not robot.family.exact
-        ch = _chain_tuple(robot.chain.placements, robot.chain.axes)
-        assert _parallel_pitches(ch)
+        ch = chain_tuple(robot.chain.placements, robot.chain.axes)
+        assert parallel_pitches(ch)
         q = robot.random_configurations(100, seed=3)
         poses = robot.fk(q)
         for n in range(q.shape[0]):
@@ -169,7 +169,7 @@ def test_parallel_pitch_steps_are_the_normal_equations_steps(tmp_path: Path) -> 
     assert np.quantile(worst, 0.99) <= 1e-9
     assert max(worst) <= 1e-6
     tilted = load_robot(tilted_urdf(paths[0]), tool="tool")
-    assert not _parallel_pitches(_chain_tuple(tilted.chain.placements, tilted.chain.axes))
+    assert not parallel_pitches(chain_tuple(tilted.chain.placements, tilted.chain.axes))
 
 
 def test_vector_path_carries_the_load() -> None:
@@ -228,14 +228,15 @@ def test_exact_branches_are_within_the_reach_tolerance() -> None:
 
 def test_sparse_chain_gives_the_same_poses() -> None:
     """The kernel's chain (frames on the joint axes that make each link R(z, phi) R(x, beta)
-    with no translation along z, ``_chain_tuple``) against ``chain_fk``: random placements and
+    with no translation along z, ``chain_tuple``) against ``chain_fk``: random placements and
     random unit axes (not only the URDFs' x/y/z), and chains with parallel axes, exactly (no
     normal common to two axes: any is taken) and tilted by 1e-12 to 1e-4 rad (the common
     normal from a tiny cross product), as in the family's pitch joints."""
     from scipy.spatial.transform import Rotation
 
     from lynxplan.robots.chain import chain_fk
-    from lynxplan.robots.ik.pose_block import _chain_tuple, _fk
+    from lynxplan.robots.ik.block_layout import chain_tuple
+    from lynxplan.robots.ik.block_newton import chain_pose
 
     rng = np.random.default_rng(12)
     for case in range(40):
@@ -251,11 +252,11 @@ def test_sparse_chain_gives_the_same_poses() -> None:
                 turn = Rotation.from_rotvec(tilt * Rotation.random(random_state=rng).as_rotvec())
                 placements[k, :3, :3] = turn.as_matrix()
                 axes[k] = axes[1]
-        chain = _chain_tuple(placements, axes)
+        chain = chain_tuple(placements, axes)
         for q in rng.uniform(-np.pi, np.pi, (10, 5)):
             expected = np.empty((4, 4))
             chain_fk(placements, axes, q, expected, np.empty((4, 4)))
-            got = np.array(_fk(chain, *q)).reshape(3, 4)
+            got = np.array(chain_pose(chain, *q)).reshape(3, 4)
             assert np.abs(got - expected[:3]).max() < 1e-14
 
 
@@ -293,20 +294,21 @@ def _flips(robot: Robot, poses: np.ndarray) -> tuple[np.ndarray, ...]:
     """Per pose: |flip 1's roll + flip 0's| (each computed from the orientation), the flip the
     screen picks, whether it marks the other, and both flips computed in full (candidate,
     fallback: 1/0), as the kernel computed them before the screen."""
-    from lynxplan.robots.ik import pose_block as pb
+    from lynxplan.robots.ik import block_closed_form as pb
+    from lynxplan.robots.ik.block_layout import link_shape
 
     family = robot.family
     assert family is not None
     pr = tuple(float(v) for v in family.packed)
-    shape = pb._shape(family.packed)
+    shape = link_shape(family.packed)
     rows = []
     for pose in poses:
         t = tuple(float(v) for v in pose[:3, :4].reshape(-1))
-        roll0, roll1 = pb._roll(pr, shape, t, 0), pb._roll(pr, shape, t, 1)
-        one, later = pb._screen(pr, shape, t, roll0)
-        first = pb._flip(pr, shape, t, 0, False, roll0)
-        # _flip turns the roll it is given by pi for flip 1: given -roll1, it uses roll1
-        other = pb._flip(pr, shape, t, 1, False, (-roll1[0], -roll1[1]))
+        roll0, roll1 = pb.orientation_roll(pr, shape, t, 0), pb.orientation_roll(pr, shape, t, 1)
+        one, later = pb.screen_flips(pr, shape, t, roll0)
+        first = pb.flip_geometry(pr, shape, t, 0, False, roll0)
+        # flip_geometry turns the roll it is given by pi for flip 1: given -roll1, it uses roll1
+        other = pb.flip_geometry(pr, shape, t, 1, False, (-roll1[0], -roll1[1]))
         gap = max(abs(roll1[0] + roll0[0]), abs(roll1[1] + roll0[1]))
         rows.append((gap, one, later, first[1], first[2], other[1], other[2]))
     return tuple(np.array(column) for column in zip(*rows, strict=True))
@@ -328,7 +330,7 @@ def _assert_screen_sound(robot: Robot, poses: np.ndarray) -> np.ndarray:
 
 
 def test_screen_leaves_out_only_flips_that_cannot_matter(tmp_path: Path) -> None:
-    """A tool off the roll axis: ``_screen`` computes one flip, and the other only where it
+    """A tool off the roll axis: ``screen_flips`` computes one flip, and the other only where it
     may matter; on the SO-101 (mixed poses: random, next to folds and the yaw axis, out of
     reach, approaches along the yaw axis, arbitrary orientations) and random off-axis family
     URDFs (exact and tilted). The other flip must be rare, or the screen saves nothing."""
