@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from lynxplan.bench import Figure, median_seconds, not_run, peer_missing
+from lynxplan.bench import Figure, median_seconds, meets, not_run, peer_missing
 from lynxplan.bench.peers import peers_dir
 
 if TYPE_CHECKING:
@@ -34,6 +34,12 @@ NUMERICAL_TRIPS, NUMERICAL_QUICK_TRIPS = 2_000, 200
 FULL_APPROACH_TRIPS, QUICK_APPROACH_TRIPS = 100_000, 2_000
 #: SO-101 full poses solved by both lynxplan and Pinocchio CLIK (zero start), full / quick.
 FULL_PEER_POSES, QUICK_PEER_POSES = 1_000, 50
+#: The guards of issue 36 (one core): robot -> figure -> target. "batch": full-pose batch IK
+#: [poses/s], "single": one ``Robot.ik`` [us], "eaik": lynxplan's batch speed-up over EAIK's.
+GOALS: dict[str, dict[str, str]] = {
+    "so101": {"batch": ">= 2e6", "single": "<= 15", "eaik": ">= 5"},
+    "al5": {"batch": ">= 6e6"},
+}
 
 
 def _warm_up(robot: object) -> None:
@@ -59,8 +65,8 @@ def _round_trips(robot: object, count: int, seed: int) -> tuple[float, float, fl
         begin = time.thread_time()
         batch = robot.ik_batch(poses)  # type: ignore[attr-defined]
         seconds.append(time.thread_time() - begin)
-        gap = np.abs(batch.q - q[:, None, :])
-        gap = np.minimum(gap, 2 * np.pi - gap % (2 * np.pi))
+        gap = np.abs(batch.q - q[:, None, :]) % (2 * np.pi)
+        gap = np.minimum(gap, 2 * np.pi - gap)
         found = np.where(batch.valid[..., None], gap, np.inf).max(axis=2).min(axis=1) < 1e-7
         errors = np.where(batch.valid, batch.position_error, 0.0).max(axis=1)
         solved += int(np.count_nonzero(found & (errors <= 1e-9)))
@@ -83,8 +89,8 @@ def _approach_round_trips(robot: Robot, count: int, seed: int) -> tuple[float, f
     batch = robot.ik_batch(positions=poses[:, :3, 3], approaches=approach)
     seconds = time.thread_time() - begin
     joints = 4 if robot.family is not None and robot.family.tool_on_roll_axis else 5
-    gap = np.abs(batch.q[..., :joints] - q[:, None, :joints])
-    gap = np.minimum(gap, 2 * np.pi - gap % (2 * np.pi)).max(axis=2)
+    gap = np.abs(batch.q[..., :joints] - q[:, None, :joints]) % (2 * np.pi)
+    gap = np.minimum(gap, 2 * np.pi - gap).max(axis=2)
     gap = np.where(batch.valid, gap, np.inf)
     exact = (batch.position_error <= 1e-12) & (batch.orientation_error <= 1e-12)
     found = (gap < 1e-7).any(axis=1) | ((gap < 1e-4) & exact).any(axis=1)
@@ -212,8 +218,9 @@ def _peers(robot: Robot, poses: np.ndarray, ours: float) -> list[Figure]:
 
 def _robot_figures(robot: Robot, quick: bool, goals: bool) -> list[Figure]:
     """Round trips, batch throughput and single-pose latency of one robot; ``goals``: show the
-    issue's SO-101 targets."""
+    robot's targets (:data:`GOALS`)."""
     name = robot.name
+    goal = GOALS.get(name, {}) if goals else {}
     if robot.family is None:  # the numerical fallback: ~1 ms a pose
         trips = NUMERICAL_QUICK_TRIPS if quick else NUMERICAL_TRIPS
         success, worst, per_pose = _verified_solves(robot, trips, seed=1)
@@ -233,8 +240,8 @@ def _robot_figures(robot: Robot, quick: bool, goals: bool) -> list[Figure]:
             f"{name} batch IK (full pose, all branches; median over chunks)",
             1 / per_pose,
             "poses/s",
-            ">= 3e6" if goals else "",
-            1 / per_pose >= 3e6 if goals else None,
+            goal.get("batch", ""),
+            meets(1 / per_pose, goal["batch"]) if "batch" in goal else None,
         ),
     ]
     if mean is not None:
@@ -264,8 +271,8 @@ def _robot_figures(robot: Robot, quick: bool, goals: bool) -> list[Figure]:
             f"{name} single-pose IK",
             seconds * 1e6,
             "us",
-            "<= 20" if goals else "",
-            seconds * 1e6 <= 20 if goals else None,
+            goal.get("single", ""),
+            meets(seconds * 1e6, goal["single"]) if "single" in goal else None,
         )
     )
     return figures
@@ -284,9 +291,11 @@ def _verified_solves(robot: Robot, count: int, seed: int) -> tuple[float, float,
     return float(exact.any(axis=1).mean()), float(errors.max()), seconds / count
 
 
-def _comparison(robot: Robot, quick: bool) -> list[Figure]:
-    """lynxplan, the peers and Pinocchio's CLIK on the same full poses of ``robot``."""
+def _comparison(robot: Robot, quick: bool, goals: bool = False) -> list[Figure]:
+    """lynxplan, the peers (EAIK in this process) and Pinocchio's CLIK on the same full poses of
+    ``robot``; ``goals``: show the issue's target of the speed-up over EAIK."""
     from lynxplan.arm.clik import solve_clik
+    from lynxplan.bench import eaik_peer
 
     name = robot.name
     count = QUICK_PEER_POSES if quick else FULL_PEER_POSES
@@ -305,8 +314,10 @@ def _comparison(robot: Robot, quick: bool) -> list[Figure]:
     clik = [solve_clik(robot.model, robot.data, robot.tool_frame_id, p, zero) for p in poses]
     clik_seconds = (time.thread_time() - begin) / count
     clik_success = float(np.mean([r.success for r in clik]))
+    eaik_goal = GOALS.get(robot.name, {}).get("eaik", "") if goals else ""
     return [
         *_peers(robot, poses, ours),
+        *eaik_peer.figures(robot, poses, ours, eaik_goal),
         Figure(
             "robots", f"{name} lynxplan IK success ({count} full poses)", 100 * ours_success, "%"
         ),
@@ -328,8 +339,8 @@ def run(quick: bool) -> list[Figure]:
 
     figures: list[Figure] = []
     for name in ("al5", "so100", "so101"):
-        figures += _robot_figures(load_robot(name), quick, goals=name == "so101")
-    figures += _comparison(load_robot("so101"), quick)
+        figures += _robot_figures(load_robot(name), quick, goals=True)
+    figures += _comparison(load_robot("so101"), quick, goals=True)
     return figures
 
 
