@@ -99,7 +99,7 @@ def test_run_a_shipped_scenario(installed: Installed, user_dir: Path) -> None:
 
 def test_bench_cold(installed: Installed, user_dir: Path) -> None:
     """Was exit 3: ``ok_task.yaml: file not found``."""
-    done = installed.run(["lynxplan", "bench", "--cold", "--json"], user_dir)
+    done = installed.run(["lynxplan", "bench", "--cold", "--quick", "--json"], user_dir)
     rows = check_bench(done, {"cold"})
     assert any(r["name"] == "lynxplan run scenarios/ok_task.yaml --quick: wall" for r in rows)
 

@@ -8,6 +8,14 @@ dropped for the children, as an installed package has its ``.pyc`` files): ``lyn
 (user + system, less sensitive to a shared machine), and each command's ratio to the pinocchio
 import. Run from a source tree, the children import that tree's lynxplan (``PYTHONPATH``), so a
 worktree measures its own code, not an editable install's.
+
+First runs (issues 36 and 37): the commands a new user types first, each once in a new process
+with its own empty numba cache (``NUMBA_CACHE_DIR``), so every kernel it needs compiles:
+``lynxplan ik`` of the SO-101 and of the AL5, ``lynxplan run`` of the shipped planning problem
+``planning/p02_box_between.yaml``, and ``lynxplan compile`` (every kernel: the price paid once).
+Their goals are wall time on the 2-core machine; the CPU time is shown too (numba compiles on
+one core, so on a machine shared with other jobs the CPU time is the figure to compare). They
+take minutes: ``--quick`` leaves them out.
 """
 
 from __future__ import annotations
@@ -19,9 +27,11 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Mapping
 from pathlib import Path
+from typing import NamedTuple
 
-from lynxplan.bench import Figure
+from lynxplan.bench import Figure, not_run
 from lynxplan.shipped import checkout_root, scenario_path
 
 SECTION = "cold"
@@ -29,6 +39,40 @@ SECTION = "cold"
 TARGET_FK_SECONDS = 0.5
 TARGET_RUN_SECONDS = 1.5
 _CLI = "import sys; from lynxplan.cli import main; sys.exit(main())"
+
+
+class FirstRun(NamedTuple):
+    """A command timed from an empty numba cache."""
+
+    name: str
+    """The command as a user types it."""
+    arguments: tuple[str, ...]
+    """Its arguments after ``lynxplan`` (``{out}``: an output folder)."""
+    goal: float | None
+    """The issue's goal in [s] of wall time, or None."""
+
+
+#: The first runs, in order (issue 36: the IK commands and compile; issue 37: the first plan).
+FIRST_RUNS: tuple[FirstRun, ...] = (
+    FirstRun(
+        "lynxplan ik --robot so101 --position 0.2 0 0.1 --approach 0 0 -1",
+        ("ik", "--robot", "so101", "--position", "0.2", "0", "0.1", "--approach", "0", "0", "-1"),
+        8.0,
+    ),
+    FirstRun(
+        "lynxplan ik --robot al5 --position 0.2 0 0.1 --pitch 60 --deg",
+        ("ik", "--robot", "al5", "--position", "0.2", "0", "0.1", "--pitch", "60", "--deg"),
+        4.0,
+    ),
+    FirstRun(
+        "lynxplan run scenarios/planning/p02_box_between.yaml",
+        ("run", "{scenario}", "--out", "{out}", "--force"),
+        30.0,
+    ),
+    FirstRun("lynxplan compile", ("compile",), None),
+)
+#: The shipped scenario of the first plan (``{scenario}`` in :data:`FIRST_RUNS`).
+FIRST_PLAN = "planning/p02_box_between.yaml"
 
 
 def _commands(out_dir: str) -> dict[str, list[str]]:
@@ -45,13 +89,17 @@ def _commands(out_dir: str) -> dict[str, list[str]]:
     }  # fmt: skip
 
 
-def time_command(command: list[str]) -> tuple[float, float]:
-    """Wall time and CPU time (user + system) of one run of ``command``, in [s].
+def time_command(
+    command: list[str], variables: Mapping[str, str] | None = None
+) -> tuple[float, float]:
+    """Wall time and CPU time (user + system) of one run of ``command``, in [s]; ``variables``:
+    environment variables set for it.
 
     Raises:
         RuntimeError: the command failed (its last stderr line is quoted).
     """
     env = {k: v for k, v in os.environ.items() if k != "PYTHONDONTWRITEBYTECODE"}
+    env.update(variables or {})
     source = checkout_root()
     if source is not None:
         # Run from a source tree (a checkout, a worktree): the children import this lynxplan,
@@ -69,8 +117,48 @@ def time_command(command: list[str]) -> tuple[float, float]:
     return wall, cpu
 
 
+def first_run_command(run: FirstRun, out_dir: str) -> list[str]:
+    """The child's command line of ``run`` (``{out}`` and ``{scenario}`` filled in)."""
+    fill = {"{out}": out_dir, "{scenario}": str(scenario_path(FIRST_PLAN))}
+    return [sys.executable, "-c", _CLI, *(fill.get(a, a) for a in run.arguments)]
+
+
+def time_first_run(run: FirstRun) -> tuple[float, float]:
+    """Wall and CPU time [s] of ``run`` in a new process with an empty numba cache of its own."""
+    with tempfile.TemporaryDirectory(prefix="lynxplan-first-run-") as tmp:
+        cache = Path(tmp) / "numba"
+        cache.mkdir()
+        command = first_run_command(run, str(Path(tmp) / "out"))
+        return time_command(command, {"NUMBA_CACHE_DIR": str(cache)})
+
+
+def first_run_figures(run: FirstRun, wall: float, cpu: float) -> list[Figure]:
+    """The figures of one first run: its wall time (judged against its goal) and CPU time."""
+    goal = "" if run.goal is None else f"<= {run.goal:g}"
+    return [
+        Figure(SECTION, f"first run, empty numba cache: {run.name}: wall", wall, "s", goal,
+               None if run.goal is None else wall <= run.goal),
+        Figure(SECTION, f"first run, empty numba cache: {run.name}: CPU (user + system)", cpu, "s"),
+    ]  # fmt: skip
+
+
+def first_runs() -> list[Figure]:
+    """Every first run of :data:`FIRST_RUNS`, one after the other (a command that fails gives a
+    ``NOT RUN`` figure with its error)."""
+    return [figure for first in FIRST_RUNS for figure in _first_run(first)]
+
+
+def _first_run(first: FirstRun) -> list[Figure]:
+    try:
+        wall, cpu = time_first_run(first)
+    except RuntimeError as error:  # the command failed: said, the other runs still run
+        return [not_run(SECTION, f"first run: {first.name}", str(error)[:300])]
+    return first_run_figures(first, wall, cpu)
+
+
 def run(quick: bool) -> list[Figure]:
-    """Median start-up times of the three commands and their ratios to the pinocchio import."""
+    """Median start-up times of the three commands and their ratios to the pinocchio import, and
+    the first runs from an empty numba cache (not with ``quick``)."""
     repeats = 3 if quick else 7
     with tempfile.TemporaryDirectory(prefix="lynxplan-cold-") as tmp:
         commands = _commands(str(Path(tmp) / "out"))
@@ -97,4 +185,4 @@ def run(quick: bool) -> list[Figure]:
                 Figure(SECTION, f"{name}: wall / pinocchio import", wall / base_wall, "x"),
                 Figure(SECTION, f"{name}: CPU / pinocchio import", cpu / base_cpu, "x"),
             ]
-    return figures
+    return figures if quick else figures + first_runs()

@@ -44,7 +44,8 @@ def register(subparsers: Any) -> None:
         "--cold",
         action="store_true",
         help="fresh-process start-up times only (section cold): fk, run ok_task --quick, "
-        "import pinocchio",
+        "import pinocchio; and first runs from an empty numba cache (ik so101/al5, run "
+        "planning/p02, compile: minutes; not with --quick)",
     )
     parser.add_argument(
         "sections", nargs="*", metavar="SECTION", help="sections to run, e.g. `bench serve`"
