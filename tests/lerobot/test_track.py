@@ -4,58 +4,34 @@ reachable False exactly where the target is out of reach."""
 
 from __future__ import annotations
 
-import math
-
 import numpy as np
 import pytest
 
 from lynxplan.exceptions import InputError
 from lynxplan.lerobot import lerobot_units
 from lynxplan.lerobot.servo import DEFAULT_FPS, DEFAULT_MAX_VELOCITY
+from lynxplan.lerobot.streams import STREAM_FRAMES, target_stream
 from lynxplan.lerobot.track import REACHED_TOLERANCE, track_targets
 from tests.lerobot.sample import SAMPLE_CALIBRATION
 
-FRAMES = 90
+FRAMES = STREAM_FRAMES
 #: A point this far from (0, 0, 0.1) m is out of the SO-101's reach (the farthest tool point of
 #: 200,000 random configurations within the URDF limits is 0.48 m from it), in [m].
 OUT_OF_REACH_RADIUS = 0.6
-SHOULDER = np.array([0.0, 0.0, 0.1])
 BOUND = DEFAULT_MAX_VELOCITY / DEFAULT_FPS
 #: The streams' pitch (pi/2 - (q2 + q3 + q4)) ignores the SO-101 model's small built-in
 #: angles, so the IK lands this near the generating path, in [rad] (the branch is the same).
 PATH_ATOL = 1e-3
 
 
-def smooth_joint_path(robot, seed: int) -> np.ndarray:
-    """A random sum of sines within 70 % of the limits, joint speeds under ~1.5 rad/s."""
-    rng = np.random.default_rng(seed)
-    lower, upper = robot.limits.lower, robot.limits.upper
-    middle, half = (lower + upper) / 2, 0.7 * (upper - lower) / 2
-    t = np.arange(FRAMES) / DEFAULT_FPS
-    path = np.empty((FRAMES, robot.nq))
-    for j in range(robot.nq):
-        amplitude = rng.uniform(0.2, 0.5, 3) * min(half[j], 0.6)
-        omega = rng.uniform(0.5, 1.2, 3)
-        phase = rng.uniform(0, 2 * math.pi, 3)
-        centre = middle[j] + rng.uniform(-0.3, 0.3) * half[j]
-        path[:, j] = centre + (amplitude * np.sin(omega * t[:, None] + phase)).sum(axis=1)
-    return np.clip(path, lower + 0.05, upper - 0.05)
-
-
 def stream(robot, seed: int, out_of_reach: bool):
     """Targets (tool point, approach pitch, roll) along a smooth joint path; optionally pushed
     radially far out of reach over frames 30..55 (smoothly in and back)."""
-    q = smooth_joint_path(robot, seed)
-    positions = robot.fk(q)[:, :3, 3].copy()
-    pitches = math.pi / 2 - q[:, 1:4].sum(axis=1)  # the family's approach pitch, nearly
-    far = np.zeros(FRAMES, dtype=bool)
-    if out_of_reach:
-        k = np.arange(FRAMES)
-        push = np.clip(np.sin(np.pi * (k - 30) / 25), 0, None) * ((k >= 30) & (k <= 55))
-        radial = positions - SHOULDER
-        positions = SHOULDER + radial * (1 + 1.2 * push[:, None])
-        far = np.linalg.norm(positions - SHOULDER, axis=1) > OUT_OF_REACH_RADIUS
-    return q, positions, pitches, q[:, 4].copy(), far
+    s = target_stream(
+        robot, seed, out_of_reach=out_of_reach, out_of_reach_radius=OUT_OF_REACH_RADIUS
+    )
+    assert s.q.shape == (FRAMES, robot.nq)
+    return s.q, s.positions, s.pitches, s.rolls, s.pushed
 
 
 @pytest.mark.parametrize("seed", range(6))
