@@ -80,6 +80,8 @@ def run_suite(args: argparse.Namespace) -> int:
             results = run_serial(problems, progress=progress)
     summaries = report.summarize(results)
     print(report.table(summaries))
+    for line in report.cpu_lines(results):
+        print(line)
     for line in report.unsolved(results):
         print(f"unsolved: {line}")
     peers: dict[str, Any] = {}

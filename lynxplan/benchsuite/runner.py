@@ -44,6 +44,10 @@ class ProblemResult:
             ``verify_time``: the planner's exact verification, in [s].
         raw_length: Joint-space length before simplification, in [rad]; ``length`` after.
         path_digest: SHA-256 of the returned waypoints' bytes ("" when unsolved).
+        solve_cpu: CPU time of this thread over the whole ``solve`` call (start/goal checks,
+            plan, simplify, verify, timing law), in [s] (NaN when unsolved). Unlike the wall
+            times, it does not grow while the process waits for a core on a loaded machine (the
+            planner runs on one thread).
     """
 
     name: str
@@ -60,6 +64,7 @@ class ProblemResult:
     raw_length: float
     length: float
     path_digest: str
+    solve_cpu: float = math.nan
 
     @property
     def total_time(self) -> float:
@@ -151,6 +156,7 @@ def run_problem(
     planner = Planner(robot, problem.obstacles())
     setup = time.perf_counter() - began
     nan = math.nan
+    cpu = time.thread_time()
     try:
         trajectory = planner.solve(problem.start, problem.goal, seed=seed, time_limit=time_limit)
     except LynxplanError as error:
@@ -158,13 +164,14 @@ def run_problem(
         return ProblemResult(problem.name, problem.robot, problem.family, False,
                              f"{type(error).__name__}: {line}", False, nan, setup, nan, nan, nan,
                              nan, nan, "")  # fmt: skip
+    cpu = time.thread_time() - cpu
     path = np.asarray(trajectory.waypoints, dtype=float)
     stats = trajectory.stats
     smallest = dense_check(robot, problem, path)
     return ProblemResult(
         problem.name, problem.robot, problem.family, True, "", smallest > 0.0, smallest, setup,
         stats.plan_time, stats.shortcut_time, stats.verify_time, stats.raw_length,
-        trajectory.path_length, hashlib.sha256(path.tobytes()).hexdigest(),
+        trajectory.path_length, hashlib.sha256(path.tobytes()).hexdigest(), cpu,
     )  # fmt: skip
 
 

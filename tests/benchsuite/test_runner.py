@@ -26,6 +26,7 @@ def test_planned_path_is_clean_and_figures_are_consistent() -> None:
     result = run_problem(problem)
     assert result.solved and result.clean and result.min_distance > 0.0
     assert result.length <= result.raw_length + 1e-9
+    assert 0.0 < result.solve_cpu < 10.0  # the whole solve() call's thread CPU time [s]
     again = run_problem(problem)
     assert again.outcome() == result.outcome()  # seeded: the same path bit for bit
     # the straight motion of the same problem is not clean for the same check
@@ -45,6 +46,7 @@ def test_bench_suite_cli_slice(tmp_path: Path) -> None:
     )  # fmt: skip
     assert done.returncode in (0, 1), done.stderr  # 1: a goal missed (timing on a loaded box)
     assert "al5    all            6/6" in done.stdout
+    assert "al5: whole solve() call, thread CPU time: median" in done.stdout
     assert (tmp_path / "cdf_total_time.png").stat().st_size > 1000
     assert (tmp_path / "results.json").is_file()
 
