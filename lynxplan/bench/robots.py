@@ -6,7 +6,9 @@ when the start configuration is among the branches and every branch reaches the 
 1e-9 m. The same for position + approach targets with the roll free. The full run uses 1e6
 trips per robot (the issue's count); ``--quick`` uses 1e4. Batch throughput: the median over
 chunks of 50,000 trips (the mean over all of them is shown too).
-Peers with conflicting requirements (placo needs pin 3.8) are not run in-process.
+Peers with conflicting requirements (placo needs pin 3.8) are not run in-process; EAIK (analytical
+IK, :mod:`lynxplan.bench.eaik_peer`) is, on the same poses as lynxplan's batch. The targets are
+the guards of issue 36 (:data:`GOALS`), shown in ``lynxplan bench robots``.
 """
 
 from __future__ import annotations
