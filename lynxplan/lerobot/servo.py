@@ -10,13 +10,17 @@ Figures (per motor, at the output shaft):
 
 - No-load speed 0.222 s/60 deg = 45 rpm = 4.712 rad/s: the STS3215 datasheet figure at 12 V
   (STS3215-C018, 30 kg.cm, 1:345, the SO-101 follower's servo), as quoted beside measurements
-  (45.7 rpm measured) in TheRobotStudio/SO-ARM100 issue #134. The 7.4 V version (C001) is
-  quoted faster (0.192 s/60 deg), so 45 rpm is the lower figure. Not checked against Feetech's
-  PDF itself here: treat it as an assumption.
-- Acceleration: the ``Acceleration`` register (address 41) counts 100 steps/s^2 per unit
-  (Feetech STS memory table, as documented with the feetech.js SDK); LeRobot's 254 gives
-  25,400 steps/s^2 = 25400 * 2 pi / 4096 = 38.96 rad/s^2, the servo's own profile cap. The
-  unit is taken from that secondary source: an assumption too.
+  (about 46 rpm measured, +-2 %) in TheRobotStudio/SO-ARM100 issue #134. The 7.4 V version
+  (C001) is quoted faster (0.192 s/60 deg = 52 rpm at 7.4 V, 0.238 s/60 deg at 6 V), so 45 rpm
+  is the lower figure. Feetech's own PDF was not read here: an assumption, from that quote.
+- Acceleration: the ``Acceleration`` register is address 41 (0x29), 1 byte, 0..254, in units of
+  100 steps/s^2 ("set to 10: 1000 steps/s^2"), per the STS/ST3215 memory table (Feetech's, as
+  reproduced with the python-st3215 driver, Mickael-Roger/python-st3215); address and size
+  match lerobot 0.4.4's ``STS_SMS_SERIES_CONTROL_TABLE`` (``"Acceleration": (41, 1)``), and
+  ``FeetechMotorsBus.configure_motors`` writes 254 there (and to ``Maximum_Acceleration``, 85)
+  at every ``connect``. So 254 x 100 = 25,400 steps/s^2 = 25400 * 2 pi / 4096 = 38.96 rad/s^2,
+  the servo's own profile cap. That the servo reaches it under an SO-101's load is an
+  assumption (not measured here).
 - Encoder: 4096 steps per turn (12 bits).
 
 Under load the speed drops (the datasheet figure is no-load), hence the default fractions.
