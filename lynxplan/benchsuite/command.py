@@ -91,7 +91,7 @@ def run_suite(args: argparse.Namespace) -> int:
         peers = compare_peers(problems, results)
         for line in peers["lines"]:
             print(line)
-    plot = report.cdf_plot(results, args.out / "cdf_total_time.png")
+    plot = report.cdf_plot(results, args.out / "cdf_total_time.png", peers.get("rows", ()))
     _write_results(args.out / "results.json", results, peers)
     print(f"outputs in {args.out}/: results.json, {plot.name}")
     misses = report.goal_misses(summaries) + list(peers.get("misses", []))

@@ -6,6 +6,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -130,28 +131,47 @@ def goal_misses(summaries: Sequence[GroupSummary]) -> list[str]:
     return misses
 
 
-def cdf_plot(results: Sequence[ProblemResult], path: Path) -> Path:
-    """A PNG of the CDF of the total time (plan + simplify + verify) per robot, log time axis;
-    an unsolved problem counts as never done (the curve stays below 1)."""
+def cdf_plot(
+    results: Sequence[ProblemResult],
+    path: Path,
+    peer_rows: Sequence[dict[str, Any]] = (),
+) -> Path:
+    """A PNG of the CDF of the total time per robot, log time axis: lynxplan's (plan + simplify
+    + verify, solid) and, from ``peer_rows`` (:func:`lynxplan.benchsuite.peers.compare_peers`),
+    each peer's (plan + simplify, dashed: OMPL, dotted: pyroboplan) on the same problems. An
+    unsolved problem counts as never done (the curve stays below 1)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    figure, axes = plt.subplots(figsize=(7, 4.5))
-    for robot in sorted({r.robot for r in results}):
+    figure, axes = plt.subplots(figsize=(8, 5))
+    styles = {"ompl": "--", "pyroboplan": ":"}
+    for k, robot in enumerate(sorted({r.robot for r in results})):
+        colour = f"C{k}"
         mine = [r for r in results if r.robot == robot]
         times = np.sort([r.total_time * 1e3 for r in mine if r.solved])
         share = np.arange(1, len(times) + 1) / len(mine)
-        axes.step(times, share, where="post", label=f"{robot} ({len(times)}/{len(mine)} solved)")
-    axes.axvline(GOAL_MEDIAN_TOTAL * 1e3, color="grey", linestyle="--", label="2 ms")
+        axes.step(times, share, where="post", color=colour,
+                  label=f"{robot} lynxplan ({len(times)}/{len(mine)})")  # fmt: skip
+        for peer, style in styles.items():
+            rows = [r for r in peer_rows
+                    if r["peer"] == peer and r["problem"].startswith(f"{robot}_")]  # fmt: skip
+            if not rows:
+                continue
+            done = np.sort([(r["plan_time"] + r["simplify_time"]) * 1e3
+                            for r in rows if r["solved"]])  # fmt: skip
+            label = f"{robot} {peer} ({len(done)}/{len(rows)})"
+            axes.step(done, np.arange(1, len(done) + 1) / len(rows), where="post", color=colour,
+                      linestyle=style, label=label)  # fmt: skip
+    axes.axvline(GOAL_MEDIAN_TOTAL * 1e3, color="grey", linestyle="-.", label="2 ms")
     axes.set_xscale("log")
-    axes.set_xlabel("total time: plan + simplify + verify [ms]")
+    axes.set_xlabel("total time per problem [ms] (lynxplan: plan + simplify + verify)")
     axes.set_ylabel("share of problems solved")
     axes.set_ylim(0, 1.02)
-    axes.set_title("SmallArmBench: lynxplan total planning time, CDF per robot")
+    axes.set_title("SmallArmBench: total planning time, CDF per robot and planner")
     axes.grid(True, which="both", alpha=0.3)
-    axes.legend(loc="lower right")
+    axes.legend(loc="upper left", fontsize="small")
     figure.tight_layout()
     path.parent.mkdir(parents=True, exist_ok=True)
     figure.savefig(path, dpi=110)

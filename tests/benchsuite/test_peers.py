@@ -47,3 +47,15 @@ def test_ur5_peer_check_agrees_with_lynxplan_on_a_problem(tmp_path: Path) -> Non
     assert valid(problem.start) and valid(problem.goal)
     line = problem.start + np.linspace(0.0, 1.0, 201)[:, None] * (problem.goal - problem.start)
     assert not all(valid(q) for q in line)
+
+
+def test_cdf_plot_draws_the_peers_beside_lynxplan(tmp_path: Path) -> None:
+    from lynxplan.benchsuite.report import cdf_plot
+    from lynxplan.benchsuite.runner import ProblemResult
+
+    ours = [ProblemResult(f"al5_bin_{k:03d}", "al5", "bin", True, "", True, 0.01, 0.01, 1e-3 * k,
+                          1e-4, 1e-4, 3.0, 2.0, "x", 2e-3) for k in range(1, 4)]  # fmt: skip
+    rows = [{"peer": "ompl", "problem": f"al5_bin_{k:03d}", "solved": k < 3, "plan_time": 0.2,
+             "simplify_time": 0.05} for k in range(1, 4)]  # fmt: skip
+    path = cdf_plot(ours, tmp_path / "cdf.png", rows)
+    assert path.stat().st_size > 1000
