@@ -13,17 +13,12 @@ from typing import Any
 import numba
 import numpy as np
 
-from lynxplan.planning.kernel_model import OBSTACLE_SPHERE, njit_no_refcount
-from lynxplan.planning.lanes import all_pair_bounds
+from lynxplan.planning.kernel_model import njit_no_refcount
+from lynxplan.planning.pair_bound import all_pair_bounds, pair_bound_below
 
 #: An edge walk stops when a pair's bound is within this of the required clearance, in [m]:
 #: every step then advances by at least this over the pair's motion rate (no endless creeping).
 STALL_DISTANCE = 2e-4
-#: Pairs whose bounding-sphere gap exceeds the clearance by more than this skip the separating
-#: axis test (its bound cannot limit a step much), in [m].
-SAT_SKIP_DISTANCE = 0.15
-#: The separating-axis bound tries the 9 edge-edge axes only below this face-axis gap, in [m].
-EDGE_AXES_BELOW = 0.02
 
 
 # -- compiled kernels ---------------------------------------------------------------------------
@@ -97,127 +92,6 @@ def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
     joint_poses(q, model, scratch)
     for g in range(model.prim_joints.shape[0]):
         primitive_pose(g, model, scratch)
-
-
-@njit_no_refcount()
-def _separating_axis_gap(
-    pa: np.ndarray,
-    ia: int,
-    ha: np.ndarray,
-    pb: np.ndarray,
-    ib: int,
-    hb: np.ndarray,
-    jb: int,
-    r: np.ndarray,
-) -> float:
-    """Largest projected gap of two oriented boxes over the SAT axes (a distance lower bound).
-
-    Box a: pose pa[ia] (4, 4) (rotation columns = box axes), half sizes ha[ia] (3,); box b: pose
-    pb[ib], half sizes hb[jb]; r: scratch (3, 3). The stacks are indexed here, not sliced (no
-    reference counting in the hot loops). The 9 edge-edge axes are only tried when the 6 face
-    axes leave a gap below :data:`EDGE_AXES_BELOW` (any subset of axes gives a valid bound).
-    """
-    t0 = pb[ib, 0, 3] - pa[ia, 0, 3]
-    t1 = pb[ib, 1, 3] - pa[ia, 1, 3]
-    t2 = pb[ib, 2, 3] - pa[ia, 2, 3]
-    for i in range(3):
-        for j in range(3):
-            r[i, j] = abs(
-                pa[ia, 0, i] * pb[ib, 0, j]
-                + pa[ia, 1, i] * pb[ib, 1, j]
-                + pa[ia, 2, i] * pb[ib, 2, j]
-            )
-    a0, a1, a2 = ha[ia, 0], ha[ia, 1], ha[ia, 2]
-    b0, b1, b2 = hb[jb, 0], hb[jb, 1], hb[jb, 2]
-    best = -np.inf
-    for i in range(3):  # axes of box a
-        proj = abs(pa[ia, 0, i] * t0 + pa[ia, 1, i] * t1 + pa[ia, 2, i] * t2)
-        gap = proj - ha[ia, i] - b0 * r[i, 0] - b1 * r[i, 1] - b2 * r[i, 2]
-        best = max(best, gap)
-    for j in range(3):  # axes of box b
-        proj = abs(pb[ib, 0, j] * t0 + pb[ib, 1, j] * t1 + pb[ib, 2, j] * t2)
-        gap = proj - hb[jb, j] - a0 * r[0, j] - a1 * r[1, j] - a2 * r[2, j]
-        best = max(best, gap)
-    if best >= EDGE_AXES_BELOW:
-        return best
-    for i in range(3):  # cross products a_i x b_j, normalised
-        ax0, ax1, ax2 = pa[ia, 0, i], pa[ia, 1, i], pa[ia, 2, i]
-        for j in range(3):
-            bx0, bx1, bx2 = pb[ib, 0, j], pb[ib, 1, j], pb[ib, 2, j]
-            l0 = ax1 * bx2 - ax2 * bx1
-            l1 = ax2 * bx0 - ax0 * bx2
-            l2 = ax0 * bx1 - ax1 * bx0
-            norm = math.sqrt(l0 * l0 + l1 * l1 + l2 * l2)
-            if norm < 1e-9:
-                continue
-            gap = abs(l0 * t0 + l1 * t1 + l2 * t2)
-            for k in range(3):
-                gap -= ha[ia, k] * abs(l0 * pa[ia, 0, k] + l1 * pa[ia, 1, k] + l2 * pa[ia, 2, k])
-                gap -= hb[jb, k] * abs(l0 * pb[ib, 0, k] + l1 * pb[ib, 1, k] + l2 * pb[ib, 2, k])
-            gap /= norm
-            best = max(best, gap)
-    return best
-
-
-@numba.njit(cache=True, inline="always")
-def _point_box_distance(
-    p: np.ndarray, ip: int, poses: np.ndarray, g: int, half: np.ndarray
-) -> float:
-    """Distance from point p[ip] (3,) to the solid box of pose poses[g] (4, 4) and half sizes
-    half[g] (3,) (0 inside)."""
-    total = 0.0
-    dx = p[ip, 0] - poses[g, 0, 3]
-    dy = p[ip, 1] - poses[g, 1, 3]
-    dz = p[ip, 2] - poses[g, 2, 3]
-    for k in range(3):
-        excess = abs(poses[g, 0, k] * dx + poses[g, 1, k] * dy + poses[g, 2, k] * dz) - half[g, k]
-        if excess > 0.0:
-            total += excess * excess
-    return math.sqrt(total)
-
-
-@numba.njit(cache=True, inline="always")
-def centre_gap(pa: np.ndarray, a: int, ra: float, pb: np.ndarray, b: int, rb: float) -> float:
-    """Gap of two bounding spheres: centres at the translations of poses pa[a], pb[b] (4, 4),
-    radii ra, rb, in [m] (a lower bound of the distance of anything inside them)."""
-    dx, dy, dz = pb[b, 0, 3] - pa[a, 0, 3], pb[b, 1, 3] - pa[a, 1, 3], pb[b, 2, 3] - pa[a, 2, 3]
-    gap: float = math.sqrt(dx * dx + dy * dy + dz * dz) - ra - rb
-    return gap
-
-
-@numba.njit(cache=True, inline="always")
-def pair_bound(p: int, model: Any, scratch: Any) -> float:
-    """Lower bound of pair p's distance at the poses in scratch.prim_poses, in [m]."""
-    return pair_bound_below(p, model, scratch, SAT_SKIP_DISTANCE)
-
-
-@numba.njit(cache=True, inline="always")
-def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
-    """:func:`pair_bound` where only whether it reaches ``enough`` [m] matters above that: the
-    bounding-sphere gap when it is at least ``min(enough, SAT_SKIP_DISTANCE)`` (no separating
-    axis test), else the tight bound. Either is a lower bound of the distance."""
-    prim_half, prim_radius, pairs = model.prim_half, model.prim_radius, model.pairs
-    kinds, centres, poses_b = model.obstacle_kinds, model.obstacle_centres, model.obstacle_poses
-    obstacle_half, obstacle_radius = model.obstacle_half, model.obstacle_radius
-    poses = scratch.prim_poses
-    a, b = pairs[p, 0], pairs[p, 1]
-    skip = min(enough, SAT_SKIP_DISTANCE)
-    if pairs[p, 2] == 1:
-        gap = centre_gap(poses, a, prim_radius[a], poses, b, prim_radius[b])
-        if gap < skip:
-            sat = _separating_axis_gap(poses, a, prim_half, poses, b, prim_half, b, scratch.sat)
-            gap = max(gap, sat)
-        return float(gap)
-    if kinds[b] == OBSTACLE_SPHERE:
-        return float(_point_box_distance(centres, b, poses, a, prim_half) - obstacle_half[b, 0])
-    dx = centres[b, 0] - poses[a, 0, 3]
-    dy = centres[b, 1] - poses[a, 1, 3]
-    dz = centres[b, 2] - poses[a, 2, 3]
-    gap = math.sqrt(dx * dx + dy * dy + dz * dz) - prim_radius[a] - obstacle_radius[b]
-    if gap < skip:
-        sat = _separating_axis_gap(poses, a, prim_half, poses_b, b, obstacle_half, b, scratch.sat)
-        gap = max(gap, sat)
-    return float(gap)
 
 
 @njit_no_refcount()

@@ -58,13 +58,12 @@ from lynxplan.planning.lanes import (
     OUT_ARMS,
     OUT_S,
     OUT_SPHERE,
-    all_pair_bounds,
     spheres_along,
 )
+from lynxplan.planning.pair_bound import all_pair_bounds, pair_bound
 from lynxplan.planning.validity import (
     joint_poses,
     joint_poses_upto,
-    pair_bound,
     primitive_pose,
     primitive_poses,
 )

@@ -42,7 +42,6 @@ from lynxplan.planning.bounds import (
     STALL_DISTANCE,
     first_below,
     joint_poses_upto,
-    pair_bound,
     primitive_pose,
     primitive_poses,
 )
@@ -52,9 +51,9 @@ from lynxplan.planning.lanes import (
     OUT_ARMS,
     OUT_BOUND,
     OUT_S,
-    all_pair_bounds,
     pair_along,
 )
+from lynxplan.planning.pair_bound import all_pair_bounds, pair_bound
 
 
 @numba.njit(cache=True, inline="always")

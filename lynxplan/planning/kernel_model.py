@@ -174,8 +174,6 @@ class Scratch(NamedTuple):
     where: np.ndarray
     #: A configuration, (nq,), in [rad].
     q: np.ndarray
-    #: The separating-axis test's work rows, (3, 3).
-    sat: np.ndarray
     #: Counters: edge checks, advancement steps, pair bounds evaluated, the pair that last
     #: failed a quick test (4,).
     counters: np.ndarray
@@ -270,7 +268,6 @@ def make_scratch(model: KernelModel) -> Scratch:
         reach=np.empty(pairs),
         where=np.empty(pairs),
         q=np.empty(nq),
-        sat=np.empty((3, 3)),
         counters=np.zeros(4, dtype=np.int64),
         arms=np.empty((2, nq)),
         dq=np.empty(nq),

@@ -38,16 +38,11 @@ import numpy as np
 
 from lynxplan.collision.world import CollisionWorld
 from lynxplan.planning.bounds import (
-    EDGE_AXES_BELOW,
     PROBES,
-    SAT_SKIP_DISTANCE,
     STALL_DISTANCE,
-    centre_gap,
     first_below,
     joint_poses,
     joint_poses_upto,
-    pair_bound,
-    pair_bound_below,
     point_is_clear,
     primitive_pose,
     primitive_poses,
@@ -57,16 +52,15 @@ from lynxplan.planning.bounds import (
 )
 from lynxplan.planning.edge_walk import edge_fraction
 from lynxplan.planning.kernel_model import CheckData, kernel_model, make_scratch, planner_pairs
+from lynxplan.planning.pair_bound import SAT_SKIP_DISTANCE, pair_bound, pair_bound_below
 
 #: The kernels live in :mod:`lynxplan.planning.bounds` (below the edge walk, which uses them);
 #: they are imported from here too.
 __all__ = [
-    "EDGE_AXES_BELOW",
     "PROBES",
     "SAT_SKIP_DISTANCE",
     "STALL_DISTANCE",
     "ValidityChecker",
-    "centre_gap",
     "first_below",
     "joint_poses",
     "joint_poses_upto",
