@@ -4,12 +4,14 @@ answers, as the bench judges them, are right (checked with lynxplan's own FK). N
 from __future__ import annotations
 
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 from lynxplan.bench import PEER_NOT_INSTALLED, eaik_peer, verdict
 from lynxplan.robots import load_robot
+from tests.robots.urdf_factory import random_family_urdf, tilted_urdf
 
 #: lynxplan's FK of the zero configuration against the chain's sums [m] and rotation entries.
 CHAIN_TOLERANCE = 1e-12
@@ -69,6 +71,23 @@ def test_the_bench_figures_of_eaik() -> None:
     ratio = rows["so101 lynxplan batch speed-up over eaik (same poses)"]
     assert np.isfinite(ratio.value) and ratio.value > 0 and ratio.target == ">= 5"
     assert verdict(ratio) == ("ok" if ratio.value >= 5 else "MISSED")
+
+
+def test_a_chain_eaik_cannot_decompose_is_said(tmp_path: Path) -> None:
+    """A 5R family arm whose pitch axes are not parallel (joint 3 tilted by 0.3 rad): EAIK knows
+    no decomposition; the bench says so in one figure (0 % solved), not a failure."""
+    if eaik_peer.eaik_module() is None:
+        pytest.skip("eaik is not installed (pip install eaik, in the [peers] extra)")
+    path = tmp_path / "arm.urdf"
+    path.write_text(random_family_urdf(np.random.default_rng(0), off_axis_tool=False))
+    robot = load_robot(str(tilted_urdf(path, 0.3, "j3")))
+    with pytest.raises(eaik_peer.UnsupportedChainError, match="no known subproblem"):
+        eaik_peer.eaik_robot(robot)
+    figures = eaik_peer.figures(robot, robot.fk(robot.random_configurations(3)), ours=1e-6)
+    assert len(figures) == 1 and figures[0].value == 0.0 and verdict(figures[0]) == ""
+    assert "cannot solve this chain" in figures[0].name
+    straight = load_robot(str(path))  # the same arm untilted: solved
+    assert eaik_peer.solve(straight, straight.fk(straight.random_configurations(5))).solved.all()
 
 
 def test_eaik_not_installed_is_said(monkeypatch: pytest.MonkeyPatch) -> None:
