@@ -1,8 +1,9 @@
-"""``lynxplan lerobot export|check``: a task as frames an SO-101 replays, and recorded data checked.
+"""``lynxplan lerobot export|check``: a motion as frames an SO-101 replays; recordings checked.
 
-- ``export SCENARIO --calibration CAL --out DIR``: the task scenario's motion (sampled at its
-  rate) as servo-safe LeRobot frames at ``--fps`` (:func:`lynxplan.lerobot.servo_frames`), written
-  as ``DIR/frames.csv`` and the LeRobot dataset ``DIR/dataset`` (one episode);
+- ``export SCENARIO --calibration CAL --out DIR``: the motion of a task, trajectory or plan
+  scenario (sampled at its rate; a plan is planned with its seed) as servo-safe LeRobot frames
+  at ``--fps`` (:func:`lynxplan.lerobot.servo_frames`), written as ``DIR/frames.csv`` and the
+  LeRobot dataset ``DIR/dataset`` (one episode);
 - ``check SOURCE --calibration CAL [--scene SCENARIO] [--out DIR]``: a LeRobot dataset's episode
   (or a frames CSV) -> FK -> tool path, limit, servo and collision checks against the scene's
   obstacles (a task or plan scenario file), figures and meshcat HTML in ``DIR``. Exit 1 when a
@@ -31,9 +32,13 @@ def register(subparsers: Any) -> None:
     actions = parser.add_subparsers(dest="action", metavar="ACTION")
     actions.required = True
     export = actions.add_parser(
-        "export", help="a task scenario as servo-safe frames (CSV) and a LeRobot dataset"
+        "export",
+        help="a task, trajectory or plan scenario as servo-safe frames (CSV) and a LeRobot dataset",
     )
-    export.add_argument("scenario", help="task scenario file (e.g. scenarios/so101_writing.yaml)")
+    export.add_argument(
+        "scenario",
+        help="task, trajectory or plan scenario file of the same robot (e.g. so101_writing.yaml)",
+    )
     export.add_argument("--out", default="out/lerobot_frames", help="output folder")
     export.add_argument("--fps", default="30", help="frame rate, a whole number (default 30)")
     export.add_argument("--gripper", default=None, help="gripper channel 0..100 of every frame")
@@ -97,16 +102,42 @@ def _scenario(path: str, kinds: tuple[str, ...]) -> Any:
     return loaded
 
 
-def _resolved_task(path: str) -> tuple[Any, Any]:
-    """A task scenario and its resolution (waypoint IK, the timed plan)."""
-    from lynxplan.exceptions import ScenarioValueError
-    from lynxplan.task.setup import resolve
+def _motion(path: str, robot_name: str) -> tuple[Any, Any, Any]:
+    """The scenario (task, trajectory or plan) and its motion's samples: ``t`` (T,) [s] and
+    ``q`` (T, n) [rad] — a task's timed plan, a trajectory's samples, a plan's planned and
+    time-parameterised path (planned with the scenario's seed, so the same frames each time).
 
-    loaded = _scenario(path, ("task",))
+    Raises:
+        InputError: the scenario's robot is not the one the frames are for, or its plan was
+            not solved (nothing to export).
+    """
+    from lynxplan.exceptions import InputError, ScenarioValueError
+    from lynxplan.scenarios.registry import kind_module
+
+    loaded = _scenario(path, ("task", "trajectory", "plan"))
+    scenario = loaded.scenario
+    named = scenario.robot.name or ("al5" if scenario.robot.urdf is None else None)
+    if named is not None and named != robot_name:
+        hint = (
+            f"pass --robot {named}" if named in ("so100", "so101") else "LeRobot drives so100/so101"
+        )
+        raise InputError(f"{path}: robot {named!r}, frames for --robot {robot_name}; {hint}")
     try:
-        return loaded.scenario, resolve(loaded.scenario)
+        if scenario.kind == "task":
+            from lynxplan.task.setup import resolve
+
+            samples = resolve(scenario).plan.sample(scenario.sample_rate)
+            return scenario, samples.t, samples.q
+        output = kind_module(scenario.kind, path).run(scenario, quick=True)
     except ScenarioValueError as exc:
         raise loaded.located(exc) from None
+    if scenario.kind == "trajectory":
+        samples = output.payload[1]
+        return scenario, samples.t, samples.q
+    if output.payload is None:  # the plan was not solved
+        raise InputError(f"{path}: {output.summary}; nothing to export")
+    trajectory = output.payload["trajectory"]
+    return scenario, trajectory.t, trajectory.q
 
 
 def _scene(path: str) -> tuple[list[Any], bool]:
@@ -135,9 +166,8 @@ def handle_export(args: argparse.Namespace) -> int:
     if gripper is not None and not 0 <= gripper <= 100:
         raise InputError(f"--gripper = {args.gripper}: must be within 0..100")
     robot, units = _robot_and_units(args)
-    scenario, setup = _resolved_task(args.scenario)
-    samples = setup.plan.sample(scenario.sample_rate)
-    frames = servo_frames(robot, units, samples.t, samples.q, gripper=gripper, fps=fps)
+    scenario, t, q = _motion(args.scenario, args.robot)
+    frames = servo_frames(robot, units, t, q, gripper=gripper, fps=fps)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     csv = write_csv(frames, out / "frames.csv", overwrite=args.overwrite)
@@ -162,7 +192,7 @@ def handle_export(args: argparse.Namespace) -> int:
     duration = frames.t[-1]
     print(
         f"{len(frames.t)} frames at {fps} fps ({duration:.2f} s, {frames.time_scale:.3g}x the "
-        f"scenario's {samples.t[-1]:.2f} s); values in {units.unit}"
+        f"scenario's {t[-1]:.2f} s); values in {units.unit}"
     )
     print(
         f"peak joint speed {math.degrees(float(frames.peak_velocity.max())):.1f} deg/s, "

@@ -129,3 +129,41 @@ def test_bad_input_is_one_line(tmp_path):
     assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
     done = _cli("lerobot", "check", tmp_path)
     assert done.returncode == 2 and "not a LeRobot dataset" in done.stderr
+
+
+def test_a_plan_scenario_exports_its_planned_motion(tmp_path):
+    """A plan (the SO-101 between two posts) is planned with its seed and exported: the frames
+    start at the scenario's start, end at a goal the scenario asks for (FK against its goal
+    position and approach), and hold the servo bounds."""
+    import yaml
+
+    from lynxplan.planning.problem import ROBOT_GOAL_ORIENTATION_TOLERANCE
+    from lynxplan.robots import load_robot
+
+    scenario = ROOT / "scenarios" / "planning" / "s02_so101_between_posts.yaml"
+    spec = yaml.safe_load(scenario.read_text())
+    done = _cli("lerobot", "export", scenario, "--fps", "30", "--out", tmp_path / "plan")
+    assert done.returncode == 0, done.stderr
+    robot = load_robot("so101")
+    units = lerobot_units(robot, None)
+    _, frames = read_csv(tmp_path / "plan" / "frames.csv")
+    q = units.to_joints(frames).q
+    np.testing.assert_allclose(np.degrees(q[0]), spec["start"], atol=1e-9)
+    tool = robot.fk(q[-1])
+    np.testing.assert_allclose(tool[:3, 3], spec["goal"]["position"], atol=1e-6)
+    # the planner's goal region: the approach within its documented orientation tolerance
+    cosine = float(np.dot(tool[:3, 2], spec["goal"]["approach"]))
+    assert math.acos(min(1.0, cosine)) <= ROBOT_GOAL_ORIENTATION_TOLERANCE * (1 + 1e-9)
+    padded = np.vstack((q[:1], q[:1], q, q[-1:], q[-1:]))
+    assert np.abs(np.diff(padded, axis=0)).max() * 30 <= DEFAULT_MAX_VELOCITY * (1 + BOUND_RTOL)
+    assert np.abs(np.diff(padded, n=2, axis=0)).max() * 900 <= DEFAULT_MAX_ACCELERATION * (
+        1 + BOUND_RTOL
+    )
+
+
+def test_a_scenario_of_another_robot_is_refused_in_one_line(tmp_path):
+    al5_plan = ROOT / "scenarios" / "planning" / "p02_box_between.yaml"
+    done = _cli("lerobot", "export", al5_plan, "--out", tmp_path / "x")
+    assert done.returncode == 2 and len(done.stderr.strip().splitlines()) == 1
+    assert "robot 'al5'" in done.stderr and "so100/so101" in done.stderr
+    assert not (tmp_path / "x").exists()
