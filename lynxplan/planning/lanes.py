@@ -2,10 +2,10 @@
 
 :func:`pair_along` computes, for one checked pair and :data:`LANES` parameters ``s_i`` of the
 straight joint edge ``q(s) = q_a + s (q_b - q_a)``, the same quantities as one step of the
-scalar edge walk (:func:`lynxplan.planning.edge_walk.pose_pair_at` and
+scalar edge walk (:func:`lynxplan.planning.motion.pose_pair_at` and
 :func:`lynxplan.planning.validity.pair_bound`): the pair's lower bound of the distance and its
 lever arms about each joint; :func:`spheres_along` the exact verification's sphere gap
-(:func:`lynxplan.planning.certify.sphere_gap`) with the same lever arms. The lanes are the
+(:func:`lynxplan.planning.sphere_gaps.sphere_gap`) with the same lever arms. The lanes are the
 innermost loop of every computation, stored as rows of a constant-width scratch array
 (structure of arrays, one row a quantity), with selects instead of branches, so LLVM turns each
 loop into SIMD instructions (several configurations for about the price of one).
@@ -204,7 +204,7 @@ def _arm_row(w: np.ndarray, rows: int, extra: float) -> None:
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
 def _arm_rows(w: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
     """Lever arms of pair p about each configuration index, every lane -> out[OUT_ARMS + j]
-    (as :func:`lynxplan.planning.edge_walk.lever_arms`)."""
+    (as :func:`lynxplan.planning.motion.lever_arms`)."""
     axes, radius, owners, joints, pairs = (
         model.axes,
         model.prim_radius,
@@ -283,7 +283,7 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
 def spheres_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.ndarray) -> None:
     """Pair p at the LANES points s_i = out[OUT_S, i] of the edge from q_a to q_b (nq,), in
     [rad]: out[OUT_SPHERE] its covering-sphere gap (the exact verification's independent bound,
-    :func:`lynxplan.planning.certify.sphere_gap`) [m], out[OUT_ARMS + j] its lever arm about
+    :func:`lynxplan.planning.sphere_gaps.sphere_gap`) [m], out[OUT_ARMS + j] its lever arm about
     configuration index j [m]; out: (3 + nq, LANES).
 
     The model must satisfy :func:`lanes_supported`.
@@ -308,7 +308,7 @@ def _cover_rows(w: np.ndarray, rows: int, c: np.ndarray, out: int) -> None:
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
 def _sphere_gap_rows(w: np.ndarray, p: int, model: Any) -> None:
-    """The covering-sphere gap of pair p (:func:`lynxplan.planning.certify.sphere_gap`) from
+    """The covering-sphere gap of pair p (:func:`lynxplan.planning.sphere_gaps.sphere_gap`) from
     rows _A (and _B), every lane -> row _BOUND, in [m]. Rows _P.._P+5 (the joint axis rows, free
     once the primitives are posed) hold sphere centres, row _T the other way round's distance."""
     pairs, centres, counts, radii, half = (

@@ -44,6 +44,7 @@ from lynxplan.planning.edge_walk import (
     state_slacks,
 )
 from lynxplan.planning.kernel_model import GRID_POINTS, njit_no_refcount, njit_refcounted
+from lynxplan.planning.space import draw_sample, nearest, steer
 from lynxplan.planning.validity import (
     ValidityChecker,
     point_is_clear,
@@ -94,20 +95,6 @@ class RrtConnectResult:
     elapsed: float
 
 
-@njit_no_refcount()
-def _nearest(nodes: np.ndarray, count: int, q: np.ndarray) -> int:
-    best, best_index = np.inf, 0
-    nq = q.shape[0]
-    for i in range(count):
-        total = 0.0
-        for j in range(nq):
-            d = nodes[i, j] - q[j]
-            total += d * d
-        if total < best:
-            best, best_index = total, i
-    return best_index
-
-
 @numba.njit(cache=True)
 def _add(
     nodes: np.ndarray,
@@ -122,40 +109,6 @@ def _add(
     parents[tree, index] = parent
     counts[tree] = index + 1
     return int(index)
-
-
-@numba.njit(cache=True, inline="always")
-def _sample(
-    lower: np.ndarray,
-    upper: np.ndarray,
-    goal_bias: float,
-    other: np.ndarray,
-    roots: int,
-    state: np.ndarray,
-    out: np.ndarray,
-) -> None:
-    """A uniform sample in the joint box, or (with probability goal_bias) a root of the other
-    tree (other: its nodes, roots: its root count) -> out (nq,)."""
-    if _rng.uniform(state) < goal_bias:
-        out[:] = other[_rng.integer(state, roots)]
-    else:
-        for j in range(out.shape[0]):
-            out[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
-
-
-@numba.njit(cache=True, inline="always")
-def _steer(q: np.ndarray, sample: np.ndarray, step: float, out: np.ndarray) -> bool:
-    """q (nq,) moved by at most ``step`` [rad] towards sample -> out; False when they coincide."""
-    distance = 0.0
-    for j in range(q.shape[0]):
-        distance += (sample[j] - q[j]) ** 2
-    distance = math.sqrt(distance)
-    if distance < 1e-12:
-        return False
-    fraction = min(1.0, step / distance)
-    for j in range(q.shape[0]):
-        out[j] = q[j] + fraction * (sample[j] - q[j])
-    return True
 
 
 class Trees(NamedTuple):
@@ -305,9 +258,9 @@ def rrt_connect_kernel(
         meta[3] += 1
         if counts[0] + 2 >= capacity or counts[1] + 2 >= capacity:
             return NODE_LIMIT
-        _sample(lower, upper, goal_bias, nodes[b], roots[b], state, sample)
-        near = _nearest(nodes[a], counts[a], sample)
-        if not _steer(nodes[a, near], sample, step, new):
+        draw_sample(lower, upper, goal_bias, nodes[b], roots[b], state, sample)
+        near = nearest(nodes[a], counts[a], sample)
+        if not steer(nodes[a, near], sample, step, new):
             meta[0] = b
             continue
         if not state_slacks(new, model, scratch, clearance, fresh):
@@ -320,7 +273,7 @@ def rrt_connect_kernel(
         slacks[a, added, :] = fresh
         known[a, added] = 1
         # Connect tree b to the new node as far as the straight edge is certified.
-        other = _nearest(nodes[b], counts[b], new)
+        other = nearest(nodes[b], counts[b], new)
         base = nodes[b, other].copy()
         length = 0.0
         for j in range(nq):

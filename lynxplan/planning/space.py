@@ -1,9 +1,15 @@
-"""The joint space: a box of joint limits, Euclidean distance, straight-line interpolation."""
+"""The joint space: a box of joint limits, Euclidean distance, straight-line interpolation.
+
+:class:`JointSpace` for Python callers; :func:`sample`, :func:`nearest` and :func:`steer` are
+the same operations compiled for the planner's kernels.
+"""
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
+import numba
 import numpy as np
 
 from lynxplan.exceptions import (
@@ -11,6 +17,8 @@ from lynxplan.exceptions import (
     NonFiniteInputError,
     ShapeError,
 )
+from lynxplan.planning import rng as _rng
+from lynxplan.planning.kernel_model import njit_no_refcount
 
 
 @dataclass(frozen=True)
@@ -83,3 +91,52 @@ class JointSpace:
                 raise ConfigurationOutsideLimitsError(what, self.joint_names[j], value, low, high)
         clipped: np.ndarray = np.clip(config, self.lower, self.upper)
         return clipped
+
+
+@njit_no_refcount()
+def nearest(nodes: np.ndarray, count: int, q: np.ndarray) -> int:
+    """Index of the row of nodes[:count] (N, nq) nearest to q (nq,) (Euclidean)."""
+    best, best_index = np.inf, 0
+    nq = q.shape[0]
+    for i in range(count):
+        total = 0.0
+        for j in range(nq):
+            d = nodes[i, j] - q[j]
+            total += d * d
+        if total < best:
+            best, best_index = total, i
+    return best_index
+
+
+@numba.njit(cache=True, inline="always")
+def draw_sample(
+    lower: np.ndarray,
+    upper: np.ndarray,
+    goal_bias: float,
+    other: np.ndarray,
+    roots: int,
+    state: np.ndarray,
+    out: np.ndarray,
+) -> None:
+    """A uniform sample in the joint box, or (with probability goal_bias) a root of the other
+    tree (other: its nodes, roots: its root count) -> out (nq,)."""
+    if _rng.uniform(state) < goal_bias:
+        out[:] = other[_rng.integer(state, roots)]
+    else:
+        for j in range(out.shape[0]):
+            out[j] = lower[j] + _rng.uniform(state) * (upper[j] - lower[j])
+
+
+@numba.njit(cache=True, inline="always")
+def steer(q: np.ndarray, sample: np.ndarray, step: float, out: np.ndarray) -> bool:
+    """q (nq,) moved by at most ``step`` [rad] towards sample -> out; False when they coincide."""
+    distance = 0.0
+    for j in range(q.shape[0]):
+        distance += (sample[j] - q[j]) ** 2
+    distance = math.sqrt(distance)
+    if distance < 1e-12:
+        return False
+    fraction = min(1.0, step / distance)
+    for j in range(q.shape[0]):
+        out[j] = q[j] + fraction * (sample[j] - q[j])
+    return True

@@ -8,7 +8,6 @@ from test_validity import BOUND_TOLERANCE, OBSTACLES
 
 from lynxplan.arm import Arm
 from lynxplan.collision import CollisionWorld
-from lynxplan.planning.certify import sphere_gap
 from lynxplan.planning.kernel_model import LANES
 from lynxplan.planning.lanes import (
     OUT_ARMS,
@@ -19,6 +18,7 @@ from lynxplan.planning.lanes import (
     spheres_along,
 )
 from lynxplan.planning.pair_bound import SAT_SKIP_DISTANCE, all_pair_bounds, pair_bound
+from lynxplan.planning.sphere_gaps import sphere_gap
 from lynxplan.planning.validity import ValidityChecker, primitive_poses
 from lynxplan.planning.verify import ExactVerifier
 
@@ -68,7 +68,7 @@ def test_all_pair_bounds_equal_the_scalar_bounds_and_stay_below_coal(
 def test_pair_and_spheres_along_match_single_steps_and_stay_below_coal(
     arm: Arm, world: CollisionWorld
 ) -> None:
-    from lynxplan.planning.edge_walk import pose_pair_at
+    from lynxplan.planning.motion import pose_pair_at
 
     checker = ValidityChecker(world, 0.0)
     verifier = ExactVerifier(world)

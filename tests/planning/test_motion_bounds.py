@@ -8,7 +8,7 @@ import pytest
 
 from lynxplan.arm import Arm
 from lynxplan.collision import BoxObstacle, CollisionWorld
-from lynxplan.planning.edge_walk import lever_arms, reach_step, span_motion
+from lynxplan.planning.motion import lever_arms, reach_step, span_motion
 from lynxplan.planning.validity import ValidityChecker, primitive_poses
 
 #: Dense samples of each tested interval.

@@ -176,7 +176,7 @@ def test_every_scheduled_row_has_its_exact_distance(arm: Arm, world: CollisionWo
 
 
 def test_covering_sphere_gaps_are_lower_bounds_of_the_exact_distances(arm: Arm) -> None:
-    """The verification's own bound (:func:`lynxplan.planning.certify.sphere_gap`: one
+    """The verification's own bound (:func:`lynxplan.planning.sphere_gaps.sphere_gap`: one
     primitive's covering spheres against the other's box) stays below coal's distance for
     every pair, self pairs and a sphere obstacle included, at random configurations; it is far
     tighter than one circumscribed sphere per primitive on the long links, which is what spares
