@@ -138,28 +138,27 @@ class GoalSet:
 
 #: A goal branch must reach the target position to this, in [m] ...
 GOAL_POSITION_TOLERANCE = 1e-9
-#: ... and a URDF robot's branch the orientation (approach axis) to this, in [rad]: its IK
-#: polishes off-family models (the SO-101's axes are 3.7e-6 rad off parallel) to ~6e-6 rad.
+#: ... and the orientation (or the approach axis) to this, in [rad]: a URDF robot's IK polishes
+#: off-family models (the SO-101's axes are 3.7e-6 rad off parallel) to ~6e-6 rad; the AL5's
+#: closed form reaches a reachable orientation to rounding.
 ROBOT_GOAL_ORIENTATION_TOLERANCE = 1e-5
+#: The last joint is a free roll of an approach goal when turning it moves the tool point and
+#: the approach axis by less than this, in [m] and [rad].
+_FREE_ROLL_TOLERANCE = 1e-9
 
 
 def _exact_solutions(
     robot: Any, pose: np.ndarray, approach_only: bool, reference: np.ndarray | None
 ) -> tuple[Any, ...]:
-    """The IK branches that reach ``pose`` (4, 4): the position exactly, and the orientation (or,
-    ``approach_only``, the approach axis) within the AL5's
-    :data:`~lynxplan.constants.STRICT_ORIENTATION_TOLERANCE` or a URDF robot's
-    :data:`ROBOT_GOAL_ORIENTATION_TOLERANCE`.
+    """The IK branches that reach ``pose`` (4, 4): the position to
+    :data:`GOAL_POSITION_TOLERANCE` and the orientation (or, ``approach_only``, the approach
+    axis) to :data:`ROBOT_GOAL_ORIENTATION_TOLERANCE`. Any robot whose ``ik(pose,
+    approach_only=..., q_reference=...)`` answers branches with ``position_error`` and
+    ``orientation_error``.
 
     Raises:
-        KinematicsError: the pose is out of reach (the AL5's strict IK; a URDF robot's nearest
-            solution misses it).
+        KinematicsError: the pose is out of reach, or its orientation.
     """
-    from lynxplan.arm.model import Arm
-
-    if isinstance(robot, Arm):
-        result = robot.ik(pose, approach_only=approach_only, strict=True, q_reference=reference)
-        return tuple(result.solutions)
     result = robot.ik(pose, approach_only=approach_only, q_reference=reference)
     exact = tuple(
         s
@@ -167,13 +166,28 @@ def _exact_solutions(
         if s.position_error <= GOAL_POSITION_TOLERANCE
         and s.orientation_error <= ROBOT_GOAL_ORIENTATION_TOLERANCE
     )
-    if not exact and result.distance > GOAL_POSITION_TOLERANCE:
-        raise UnreachablePoseError(result.distance, "nearest solution of the robot's IK")
-    if not exact:
-        raise OrientationNotReachableError(
-            result.orientation_residual, ROBOT_GOAL_ORIENTATION_TOLERANCE
-        )
-    return exact
+    if exact:
+        return exact
+    miss = min((float(s.position_error) for s in result.solutions), default=np.inf)
+    if miss > GOAL_POSITION_TOLERANCE:
+        raise UnreachablePoseError(miss, "nearest solution of the robot's IK")
+    raise OrientationNotReachableError(
+        result.orientation_residual, ROBOT_GOAL_ORIENTATION_TOLERANCE
+    )
+
+
+def _roll_is_free(robot: Any, space: JointSpace) -> bool:
+    """Whether turning the last joint moves neither the tool point nor the approach axis (the
+    tool z axis), from the robot's ``fk`` at a configuration inside the limits: then the roll of
+    an approach goal is that joint's angle alone (the AL5)."""
+    q = 0.5 * (space.lower + space.upper)
+    turned = q.copy()
+    turned[-1] = space.lower[-1] + 0.25 * (space.upper[-1] - space.lower[-1])
+    if turned[-1] == q[-1]:
+        return False
+    before, after = np.asarray(robot.fk(q)), np.asarray(robot.fk(turned))
+    moved = np.abs(before[:3, 2:4] - after[:3, 2:4]).max()
+    return bool(moved <= _FREE_ROLL_TOLERANCE)
 
 
 def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> GoalSet:
@@ -190,17 +204,15 @@ def goal_configurations(robot: Any, space: JointSpace, goal: Goal | Any) -> Goal
         goal = PoseGoal(array) if array.shape == (4, 4) else JointGoal(array)
     if isinstance(goal, JointGoal):
         return GoalSet(space.check(goal.q, "goal")[None, :], ("joint goal",))
-    from lynxplan.arm.model import Arm
-
     approach_only = isinstance(goal, ApproachGoal)
     pose = goal.pose if isinstance(goal, PoseGoal) else goal.pose_at(0.0)
     rolls: np.ndarray | None = None
     reference = None
-    if isinstance(goal, ApproachGoal) and isinstance(robot, Arm):
-        # The AL5's approach axis is its roll axis, with the tool point on it: the roll moves
-        # neither, so each sampled roll of the last joint has the same branches in the other
-        # joints (the IK sets q5 to the reference's). One IK, the roll set to each sample.
-        # (A URDF robot's IK leaves the roll free for an approach goal: every root, exactly.)
+    if isinstance(goal, ApproachGoal) and _roll_is_free(robot, space):
+        # The approach axis is the last joint's axis, with the tool point on it (the AL5): the
+        # roll moves neither, so each sampled roll of that joint has the same branches in the
+        # other joints (the IK sets it to the reference's). One IK, the roll set to each sample.
+        # (Otherwise the IK leaves the roll free for an approach goal: every root, exactly.)
         rolls = np.linspace(space.lower[-1], space.upper[-1], goal.roll_samples)
         reference = np.zeros(space.dimension)
         reference[-1] = rolls[0]
