@@ -125,19 +125,11 @@ def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float,
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
-def _angle_of_matrix(
-    m00: float,
-    m01: float,
-    m02: float,
-    m10: float,
-    m11: float,
-    m12: float,
-    m20: float,
-    m21: float,
-    m22: float,
-) -> float:
-    """Rotation angle of the rotation matrix M, in [rad], accurate near 0 (atan2 of sine and
-    cosine; the small-angle series by a select, so array loops over it vectorise)."""
+def _angle_of_matrix(m: tuple[float, ...]) -> float:
+    """Rotation angle of the rotation matrix M (its 9 entries, row-major), in [rad], accurate
+    near 0 (atan2 of sine and cosine; the small-angle series by a select, so array loops over
+    it vectorise)."""
+    m00, m01, m02, m10, m11, m12, m20, m21, m22 = m
     sx, sy, sz = 0.5 * (m21 - m12), 0.5 * (m02 - m20), 0.5 * (m10 - m01)
     sine = math.sqrt(sx * sx + sy * sy + sz * sz)
     cosine = 0.5 * (m00 + m11 + m22 - 1.0)
@@ -157,15 +149,17 @@ def _angle_between_frames(
 ) -> float:
     """Rotation angle of R_t^T R_s, in [rad], accurate near 0 (atan2 of sine and cosine)."""
     return _angle_of_matrix(
-        _dot3(n_t, n_s),
-        _dot3(n_t, o_s),
-        _dot3(n_t, a_s),
-        _dot3(o_t, n_s),
-        _dot3(o_t, o_s),
-        _dot3(o_t, a_s),
-        _dot3(a_t, n_s),
-        _dot3(a_t, o_s),
-        _dot3(a_t, a_s),
+        (
+            _dot3(n_t, n_s),
+            _dot3(n_t, o_s),
+            _dot3(n_t, a_s),
+            _dot3(o_t, n_s),
+            _dot3(o_t, o_s),
+            _dot3(o_t, a_s),
+            _dot3(a_t, n_s),
+            _dot3(a_t, o_s),
+            _dot3(a_t, a_s),
+        )
     )
 
 
@@ -345,15 +339,17 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         os0, os1, os2 = -s5 * x4x + c5 * s1, -s5 * x4y - c5 * c1, -s5 * x4z
         ox, oy, oz = ay * nz - az * ny, az * nx - ax * nz, ax * ny - ay * nx  # o_t = a_t x n_t
         frame_residual = _angle_of_matrix(
-            nx * ns0 + ny * ns1 + nz * ns2,
-            nx * os0 + ny * os1 + nz * os2,
-            nx * as0 + ny * as1 + nz * as2,
-            ox * ns0 + oy * ns1 + oz * ns2,
-            ox * os0 + oy * os1 + oz * os2,
-            ox * as0 + oy * as1 + oz * as2,
-            ax * ns0 + ay * ns1 + az * ns2,
-            ax * os0 + ay * os1 + az * os2,
-            dot,
+            (
+                nx * ns0 + ny * ns1 + nz * ns2,
+                nx * os0 + ny * os1 + nz * os2,
+                nx * as0 + ny * as1 + nz * as2,
+                ox * ns0 + oy * ns1 + oz * ns2,
+                ox * os0 + oy * os1 + oz * os2,
+                ox * as0 + oy * as1 + oz * as2,
+                ax * ns0 + ay * ns1 + az * ns2,
+                ax * os0 + ay * os1 + az * os2,
+                dot,
+            )
         )
         residual = approach_residual if approach_only else frame_residual
         s[_STATUS, i] = status

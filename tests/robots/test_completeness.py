@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from lynxplan.robots import Robot, load_robot
-from lynxplan.robots.ik.numerical import numerical_ik_kernel
+from lynxplan.robots.ik.numerical import NumericalArm, NumericalResult, numerical_ik_kernel
 
 STARTS = 400
 TARGETS = 12
@@ -19,27 +19,16 @@ def _dense_search(robot: Robot, pose: np.ndarray, approach_only: bool) -> np.nda
     rng = np.random.default_rng(1)
     starts = rng.uniform(robot.limits.lower, robot.limits.upper, size=(STARTS, robot.nq))
     targets = np.repeat(pose[None], STARTS, axis=0)
-    q = np.empty((STARTS, robot.nq))
-    ok = np.empty(STARTS, dtype=bool)
-    perr, oerr = np.empty(STARTS), np.empty(STARTS)
-    iterations = np.empty(STARTS, dtype=np.int64)
-    numerical_ik_kernel(
+    arm = NumericalArm(
         robot.chain.placements,
         robot.chain.axes,
-        targets,
-        approach_only,
         robot.limits.lower.copy(),
         robot.limits.upper.copy(),
-        starts,
-        np.empty((0, robot.nq)),
-        q,
-        ok,
-        perr,
-        oerr,
-        iterations,
         np.array([0.0, 0.0, 1.0]),
     )
-    return q[ok]
+    result = NumericalResult.empty(STARTS, robot.nq)
+    numerical_ik_kernel(arm, targets, approach_only, starts, np.empty((0, robot.nq)), result)
+    return result.q[result.success]
 
 
 @pytest.mark.parametrize("name", ["so101", "so100", "al5"])

@@ -43,7 +43,7 @@ def _both(robot: Robot, poses: np.ndarray, reference: np.ndarray) -> tuple[tuple
             chain.axes,
             kernel_input(poses),
             kernel_input(reference),
-            *out,
+            out,
             solved,
             distance,
         )
@@ -212,7 +212,7 @@ def test_block_errors_are_pinocchio_fk_at_the_returned_angles() -> None:
 
 
 def test_exact_branches_are_within_the_reach_tolerance() -> None:
-    """``solve_family`` returns the pose kernels' batch as it is when every target has exact
+    """``solve_poses`` returns the pose kernels' batch as it is when every target has exact
     branches: each reaches its target within REACH_TOLERANCE (so it is reachable, and no
     branch is dropped)."""
 

@@ -26,6 +26,7 @@ from lynxplan.robots.ik.block_layout import (
     Branches,
     FlipBranches,
     Floats,
+    SinCos,
     atan2,
     column_of,
     put_candidate,
@@ -299,8 +300,12 @@ def flip_branches(pr: Floats, shape: Floats, geometry: Floats) -> Branches:
     # the sines and cosines of the angles, from those of toward, bend, delta and the constants
     s_to, c_to = unit_terms(ry, rx)
     s_be, c_be = unit_terms(lb * sd, la + lb * cd)
-    sines_up, cosines_up = elbow_terms(shape, sigma, s_to, c_to, s_be, c_be, -sd, cd, sp, cp)
-    sines_down, cosines_down = elbow_terms(shape, sigma, s_to, c_to, -s_be, c_be, sd, cd, sp, cp)
+    sines_up, cosines_up = elbow_terms(
+        shape, sigma, (s_to, c_to), (s_be, c_be), (-sd, cd), (sp, cp)
+    )
+    sines_down, cosines_down = elbow_terms(
+        shape, sigma, (s_to, c_to), (-s_be, c_be), (sd, cd), (sp, cp)
+    )
     s1, s5 = sigma[0] * s2, sigma[4] * st
     return (
         up,
@@ -316,20 +321,19 @@ def flip_branches(pr: Floats, shape: Floats, geometry: Floats) -> Branches:
 def elbow_terms(
     shape: Floats,
     sigma: Floats,
-    s_to: float,
-    c_to: float,
-    s_be: float,
-    c_be: float,
-    s_de: float,
-    c_de: float,
-    s_big: float,
-    c_big: float,
+    toward: SinCos,
+    bend: SinCos,
+    delta: SinCos,
+    big: SinCos,
 ) -> tuple[Floats, Floats]:
-    """The sines and cosines of q2, q3, q4 of one elbow (``flip_geometry``): q2 = toward + bend -
-    b2,
-    q3 = b2 - b3 + delta' and q4 = big - q2 - q3, each times its sign sigma (5, all joints),
-    from the sines and cosines of toward, bend (its sign the elbow's), delta' (-delta for the
+    """The sines and cosines of q2, q3, q4 of one elbow (``flip_geometry``): q2 = toward +
+    bend - b2, q3 = b2 - b3 + delta' and q4 = big - q2 - q3, each times its sign sigma (5, all
+    joints), from the (sin, cos) of toward, bend (its sign the elbow's), delta' (-delta for the
     elbow up) and the pitch sum big; shape[7:11]: those of b2 and b2 - b3."""
+    s_to, c_to = toward
+    s_be, c_be = bend
+    s_de, c_de = delta
+    s_big, c_big = big
     s_b2, c_b2, s_23, c_23 = shape[7], shape[8], shape[9], shape[10]
     s_a, c_a = s_to * c_be + c_to * s_be, c_to * c_be - s_to * s_be  # toward + bend
     s_q2, c_q2 = s_a * c_b2 - c_a * s_b2, c_a * c_b2 + s_a * s_b2

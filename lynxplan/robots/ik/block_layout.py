@@ -25,6 +25,8 @@ from lynxplan.robots import family as F  # noqa: N812
 FAST = {"contract", "arcp"}  # fused multiply-adds, reciprocals: as in ``arm.ik_kernel``
 #: Floats in registers: a pose (12, row-major 3 x 4), a Jacobian column (6), the parameters.
 Floats = tuple[float, ...]
+#: The sine and cosine of an angle.
+SinCos = tuple[float, float]
 #: One flip (``flip_geometry``): its geometry (12, where ``flip_branches`` finds the angles),
 #: candidate, fallback, side, near a fold.
 FlipBranches = tuple[Floats, bool, bool, float, bool]

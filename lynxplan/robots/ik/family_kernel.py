@@ -15,6 +15,7 @@ Every branch is then verified by FK of the exact chain. Angles in [rad], lengths
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -44,6 +45,7 @@ from lynxplan.robots.ik.roll_search import (
     roll_candidates,
     sample_roll_grid,
 )
+from lynxplan.robots.results import BranchSlots
 
 __all__ = [
     "MAX_ROOTS",
@@ -55,21 +57,29 @@ __all__ = [
 ]
 
 
+class KernelTargets(NamedTuple):
+    """The targets of :func:`family_ik_kernel` (kernel inputs: writable, C-contiguous)."""
+
+    poses: np.ndarray
+    """(N, 4, 4); for approach targets only column 2 (approach) and 3 count [m]."""
+    mode: int
+    """MODE_POSE, MODE_APPROACH or MODE_PITCH."""
+    pitch: np.ndarray
+    """(N,) approach pitch for MODE_PITCH [rad] (from straight down towards outward)."""
+    roll: np.ndarray
+    """(N,) roll joint angle [rad], NaN where free."""
+    reference: np.ndarray
+    """(N, 5) or (1, 5) joint angles [rad]: yaw on the base axis, the pitch sum when the
+    approach is along the pitch axis, the roll where free and not determined."""
+
+
 @numba.njit(cache=True, nogil=True)
 def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per pose)
     prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,
-    targets: np.ndarray,
-    mode: int,
-    pitch: np.ndarray,
-    roll: np.ndarray,
-    reference: np.ndarray,
-    q_out: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    position_error: np.ndarray,
-    orientation_error: np.ndarray,
+    goals: KernelTargets,
+    slots: BranchSlots,
     miss_out: np.ndarray,
 ) -> None:
     """Every branch of N targets.
@@ -77,21 +87,17 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
     Args:
         prm: Packed family parameters (``family.py``).
         placements, axes: The exact chain (``chain.py``).
-        targets: (N, 4, 4) poses; for approach targets only column 2 (approach) and 3 count.
-        mode: MODE_POSE, MODE_APPROACH or MODE_PITCH.
-        pitch: (N,) approach pitch for MODE_PITCH [rad] (from straight down towards outward).
-        roll: (N,) roll joint angle [rad], NaN where free.
-        reference: (N, 5) or (1, 5) joint angles [rad]: yaw on the base axis, the pitch sum when
-            the approach is along the pitch axis, the roll where free and not determined.
-        q_out: (N, B, 5) output angles; B = 4 (closed form) or 4 * MAX_ROOTS (root search).
-        valid, within: (N, B) output flags (branch exists; within joint limits).
-        position_error, orientation_error: (N, B) output, [m] and [rad] on the exact chain.
+        goals: The N targets and their reference (:class:`KernelTargets`).
+        slots: (N, B, ...) outputs (:class:`BranchSlots`): angles, flags (branch exists;
+            within joint limits), position and orientation errors on the exact chain [m],
+            [rad]; B = 4 (closed form) or 4 * MAX_ROOTS (root search).
         miss_out: (N, B) output: by how much the closed form missed the reach, [m].
     """
+    targets, mode, pitch, roll, reference = goals
+    q_out, valid, within, position_error, orientation_error = slots
     nb = q_out.shape[1]
     per_side = nb // 2
     lower, upper = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5]
-    tol = prm[F.LIMIT_TOL]
     sig5 = prm[F.SIGMA + 4]
     lo5, hi5 = sig5 * lower[4], sig5 * upper[4]
     if lo5 > hi5:
@@ -232,7 +238,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         ):
                             rg = q[4]
                         polish(chain_problem, rg, q, scratch, scratch4, scratch5)
-                    inside, err = settle(placements, axes, lower, upper, tol, target, q, pose, work)
+                    inside, err = settle(prm, placements, axes, target, q, pose, work)
                     # the same branch reached twice (merged roots, a fold)
                     if is_duplicate(q_out[n], valid[n], b, q, BRANCH_DUPLICATE_TOLERANCE):
                         continue

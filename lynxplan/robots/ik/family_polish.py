@@ -240,24 +240,23 @@ def axis_angle(a0: float, a1: float, a2: float, t0: float, t1: float, t2: float)
 
 @numba.njit(cache=True, nogil=True)
 def settle(
+    prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,
-    lower: np.ndarray,
-    upper: np.ndarray,
-    tol: float,
     target: np.ndarray,
     q: np.ndarray,
     pose: np.ndarray,
     work: np.ndarray,
     current: bool = False,
 ) -> tuple[bool, float]:
-    """A branch's angles q (5,) wrapped into the limits in place (snapping within tol); its
-    pose on the exact chain into pose (4, 4) (work: scratch), unless pose is ``current`` (holds
-    the pose at q) and no angle moved. Returns (within the limits, position error against
-    target [m])."""
+    """A branch's angles q (5,) wrapped in place into the limits of the packed parameters prm
+    (snapping within their tolerance); its pose on the exact chain into pose (4, 4) (work:
+    scratch), unless pose is ``current`` (holds the pose at q) and no angle moved. Returns
+    (within the limits, position error against target [m])."""
     inside = True
+    tol = prm[F.LIMIT_TOL]
     for j in range(5):
-        x, ok = wrap_into_limits(q[j], lower[j], upper[j], tol)
+        x, ok = wrap_into_limits(q[j], prm[F.LOWER + j], prm[F.UPPER + j], tol)
         current = current and x == q[j]
         q[j] = x
         inside = inside and ok

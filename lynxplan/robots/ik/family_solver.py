@@ -15,7 +15,7 @@ from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
-from lynxplan.robots.ik.pose_block import BLOCK, pose_block_kernel
+from lynxplan.robots.ik.pose_block import pose_block_kernel
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
 
@@ -65,39 +65,60 @@ def needs_root_search(kinematics: Kinematics, target: Target) -> bool:
     )
 
 
-def solve_family(kinematics: Kinematics, target: Target, reference: np.ndarray) -> RobotIkBatch:
-    """Every branch of each target (see ``family_kernel``)."""
-    family = kinematics.family
-    assert family is not None
+def solve_poses(
+    kinematics: Kinematics, target: Target, reference: np.ndarray, block: bool
+) -> RobotIkBatch:
+    """Full poses, roll free: the closed form (``pose_block`` when ``block``, else the scalar
+    ``pose_kernel``) gives each pose it solves its exact branches, each within
+    REACH_TOLERANCE; the rest (out of reach, degenerate, a given roll) goes through the roll
+    search (``family_kernel``) and the near-axis rescue, its roots packed into the pose layout."""
     n = target.poses.shape[0]
     slots = slot_count(kinematics, target)
     out = BranchSlots.empty(n, slots)
-    if target.kind == fk_.MODE_POSE and kinematics.arm is None:
-        # the poses pose_block solves have their exact branches, each within REACH_TOLERANCE;
-        # the rest (out of reach, degenerate) goes through the general kernel (root search),
-        # its roots packed into the pose layout
-        # the rows by index: a boolean mask would be scanned whole by each of the ~10 uses
-        distance = np.empty(n)
-        rest = np.flatnonzero(~_pose_fill(kinematics, target, reference, out, distance))
-        reachable = np.ones(n, dtype=np.bool_)
-        if rest.size:
-            sub, ref = _rows(target, reference, rest)
-            part = BranchSlots.empty(sub.poses.shape[0], 4 if slots == 4 else 4 * fk_.MAX_ROOTS)
-            _kernel(kinematics, sub, ref, part)
-            reachable[rest], distance[rest] = _general(kinematics, sub, part)
-            out.put(rest, pack_rolls(part, slots // 4))
-    else:
-        if kinematics.arm is not None and target.kind != fk_.MODE_PITCH:
-            out.clear()
-            rest = ~al5_fill(kinematics, target, reference, out)
-            if rest.any():
-                sub, ref = _rows(target, reference, rest)
-                part = out.rows(rest)
-                _kernel(kinematics, sub, ref, part)
-                out.put(rest, part)
-        else:
-            _kernel(kinematics, target, reference, out)
-        reachable, distance = _general(kinematics, target, out)
+    # the rows by index: a boolean mask would be scanned whole by each of the ~10 uses
+    distance = np.empty(n)
+    rest = np.flatnonzero(~_pose_fill(kinematics, target, reference, out, distance, block))
+    reachable = np.ones(n, dtype=np.bool_)
+    if rest.size:
+        sub, ref = _rows(target, reference, rest)
+        part = BranchSlots.empty(sub.poses.shape[0], 4 if slots == 4 else 4 * fk_.MAX_ROOTS)
+        _kernel(kinematics, sub, ref, part)
+        reachable[rest], distance[rest] = _general(kinematics, sub, part)
+        out.put(rest, pack_rolls(part, slots // 4))
+    return _batch(out, reachable, distance, slots)
+
+
+def solve_al5(kinematics: Kinematics, target: Target, reference: np.ndarray) -> RobotIkBatch:
+    """The AL5's full poses and approach targets: the kernels of ``lynxplan.arm``
+    (``al5_bridge``); the targets they leave go through the roll search."""
+    slots = slot_count(kinematics, target)
+    out = BranchSlots.empty(target.poses.shape[0], slots)
+    out.clear()
+    rest = ~al5_fill(kinematics, target, reference, out)
+    if rest.any():
+        sub, ref = _rows(target, reference, rest)
+        part = out.rows(rest)
+        _kernel(kinematics, sub, ref, part)
+        out.put(rest, part)
+    reachable, distance = _general(kinematics, target, out)
+    return _batch(out, reachable, distance, slots)
+
+
+def solve_roll_search(
+    kinematics: Kinematics, target: Target, reference: np.ndarray
+) -> RobotIkBatch:
+    """Approach and pitch targets, and a given roll: the roll search (``family_kernel``), then
+    the near-axis rescue (numerical, on a model only close to the family)."""
+    slots = slot_count(kinematics, target)
+    out = BranchSlots.empty(target.poses.shape[0], slots)
+    _kernel(kinematics, target, reference, out)
+    reachable, distance = _general(kinematics, target, out)
+    return _batch(out, reachable, distance, slots)
+
+
+def _batch(
+    out: BranchSlots, reachable: np.ndarray, distance: np.ndarray, slots: int
+) -> RobotIkBatch:
     q, valid, within, perr, oerr = out
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)
@@ -165,7 +186,7 @@ def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -
 
     The numerical solver accepts only answers that reach the pose to 1e-10 m and 1e-9 rad.
     """
-    from lynxplan.robots.ik.numerical import numerical_ik_kernel
+    from lynxplan.robots.ik.numerical import NumericalArm, NumericalResult, numerical_ik_kernel
 
     q, valid, within, perr, oerr = out
     family = kinematics.family
@@ -191,6 +212,8 @@ def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -
         near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
         rows = np.flatnonzero(near & near_miss & (exact_count == 0))
     axis = np.array(family.approach_in_tool)
+    chain = kinematics.chain
+    arm = NumericalArm(chain.placements, chain.axes, lower, upper, axis)
     for row in rows:
         branches = q[row][valid[row]]
         if approach_only:
@@ -205,26 +228,16 @@ def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -
             )
             seeds = np.ascontiguousarray(np.vstack((branches, extra)))
         n = seeds.shape[0]
-        found = np.empty((n, 5))
-        ok = np.empty(n, dtype=np.bool_)
-        p_err, o_err = np.empty(n), np.empty(n)
-        iterations = np.empty(n, dtype=np.int64)
+        result = NumericalResult.empty(n, 5)
         numerical_ik_kernel(
-            kinematics.chain.placements,
-            kinematics.chain.axes,
+            arm,
             np.repeat(target.poses[row : row + 1], n, 0),
             approach_only,
-            lower,
-            upper,
             seeds,
             np.empty((0, 5)),
-            found,
-            ok,
-            p_err,
-            o_err,
-            iterations,
-            axis,
+            result,
         )
+        found, ok, p_err, o_err, _ = result
         for i in np.flatnonzero(ok):
             taken = q[row][valid[row]]
             if taken.size and np.abs(taken - found[i]).max(axis=1).min() < 1e-9:
@@ -247,12 +260,14 @@ def _kernel(
         family.packed,
         kinematics.chain.placements,
         kinematics.chain.axes,
-        kernel_input(target.poses),
-        target.kind,
-        kernel_input(target.pitch),
-        kernel_input(target.roll),
-        kernel_input(reference),
-        *out,
+        fk_.KernelTargets(
+            kernel_input(target.poses),
+            target.kind,
+            kernel_input(target.pitch),
+            kernel_input(target.roll),
+            kernel_input(reference),
+        ),
+        out,
         miss,
     )
 
@@ -305,22 +320,23 @@ def _pose_fill(
     reference: np.ndarray,
     out: BranchSlots,
     distance: np.ndarray,
+    block: bool,
 ) -> np.ndarray:
-    """Full poses the orientation solves in closed form (``pose_kernel``; from a block of poses
-    on, its vectorised form ``pose_block``); returns which. The others (out of reach,
+    """Full poses the orientation solves in closed form (``pose_block`` when ``block``, else
+    the scalar ``pose_kernel``); returns which. The others (out of reach,
     degenerate, a given roll) need the general kernel (root search). distance (N,): output,
     each target's smallest position error over its slots [m]."""
     family = kinematics.family
     assert family is not None
     solved = np.empty(target.poses.shape[0], dtype=np.bool_)
-    kernel = pose_block_kernel if target.poses.shape[0] >= BLOCK else _pk.pose_kernel
+    kernel = pose_block_kernel if block else _pk.pose_kernel
     kernel(
         family.packed,
         kinematics.chain.placements,
         kinematics.chain.axes,
         kernel_input(target.poses),
         kernel_input(reference),
-        *out,
+        out,
         solved,
         distance,
     )

@@ -10,6 +10,7 @@ reported, never returned as solutions.
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -80,34 +81,67 @@ def _angle(pose: np.ndarray, target: np.ndarray, approach_only: bool, u: np.ndar
     return math.atan2(0.5 * math.sqrt(s0 * s0 + s1 * s1 + s2 * s2), 0.5 * (tr - 1.0))
 
 
+class NumericalArm(NamedTuple):
+    """What :func:`numerical_ik_kernel` knows of the arm (writable, C-contiguous arrays)."""
+
+    placements: np.ndarray
+    """(n + 1, 4, 4) joint placements and the tool's (``chain.py``) [m]."""
+    axes: np.ndarray
+    """(n, 3) joint axes (unit vectors)."""
+    lower: np.ndarray
+    """(n,) lower joint limits [rad]."""
+    upper: np.ndarray
+    """(n,) upper joint limits [rad]."""
+    approach_axis: np.ndarray
+    """(3,) the tool's approach axis in the tool frame (unit vector)."""
+
+
+class NumericalResult(NamedTuple):
+    """The outputs of :func:`numerical_ik_kernel` for N targets."""
+
+    q: np.ndarray
+    """(N, n) best configuration found [rad]."""
+    success: np.ndarray
+    """(N,) bool: verified within tolerance."""
+    position_error: np.ndarray
+    """(N,) of q [m]."""
+    orientation_error: np.ndarray
+    """(N,) of q [rad]."""
+    iterations: np.ndarray
+    """(N,) int64: total iterations used."""
+
+    @classmethod
+    def empty(cls, n: int, nq: int) -> NumericalResult:
+        """Uninitialised outputs (the kernel writes every row)."""
+        return cls(
+            np.empty((n, nq)),
+            np.empty(n, dtype=np.bool_),
+            np.empty(n),
+            np.empty(n),
+            np.empty(n, dtype=np.int64),
+        )
+
+
 @numba.njit(cache=True, nogil=True)
 def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per pose)
-    placements: np.ndarray,
-    axes: np.ndarray,
+    arm: NumericalArm,
     targets: np.ndarray,
     approach_only: bool,
-    lower: np.ndarray,
-    upper: np.ndarray,
     reference: np.ndarray,
     starts: np.ndarray,
-    q_out: np.ndarray,
-    success: np.ndarray,
-    position_error: np.ndarray,
-    orientation_error: np.ndarray,
-    iterations: np.ndarray,
-    approach_axis: np.ndarray,
+    result: NumericalResult,
 ) -> None:
     """Levenberg-Marquardt IK of N targets (see module docstring).
 
     Args:
+        arm: The chain, its limits and the tool's approach axis (:class:`NumericalArm`).
         targets: (N, 4, 4) poses [m]; approach_only: only column 2 of the rotation counts: the
-            tool axis ``approach_axis`` (tool-frame unit vector, (3,)) must point along it.
-        lower, upper: (n,) joint limits [rad].
+            tool axis ``arm.approach_axis`` must point along it.
         reference: (N, n) or (1, n) first start [rad]; starts: (S, n) further starts [rad].
-        q_out: (N, n) best configuration found; success: (N,) verified within tolerance.
-        position_error, orientation_error: (N,) of q_out, [m] and [rad].
-        iterations: (N,) total iterations used.
+        result: The outputs (:class:`NumericalResult`).
     """
+    placements, axes, lower, upper, approach_axis = arm
+    q_out, success, position_error, orientation_error, iterations = result
     n = axes.shape[0]
     pose, work = np.empty((4, 4)), np.empty((4, 4))
     jac = np.empty((6, n))

@@ -31,26 +31,18 @@ def solve_numerical(
     finite_upper = np.where(np.isfinite(upper), upper, np.pi)
     rng = np.random.default_rng(START_SEED)
     seeds = rng.uniform(finite_lower, finite_upper, size=(starts, kinematics.nq))
-    q = np.empty((n, kinematics.nq))
-    success = np.empty(n, dtype=np.bool_)
-    perr, oerr = np.empty(n), np.empty(n)
-    iterations = np.empty(n, dtype=np.int64)
+    result = num.NumericalResult.empty(n, kinematics.nq)
+    chain = kinematics.chain
+    arm = num.NumericalArm(chain.placements, chain.axes, lower, upper, np.array([0.0, 0.0, 1.0]))
     num.numerical_ik_kernel(
-        kinematics.chain.placements,
-        kinematics.chain.axes,
+        arm,
         target.poses,
         target.kind == 1,
-        lower,
-        upper,
         np.ascontiguousarray(reference, dtype=float),
         seeds,
-        q,
-        success,
-        perr,
-        oerr,
-        iterations,
-        np.array([0.0, 0.0, 1.0]),
+        result,
     )
+    q, success, perr, oerr, _ = result
     within = success.copy()
     arrays = (
         q[:, None, :],

@@ -73,11 +73,13 @@ from lynxplan.robots.ik.block_settle import polish_settle, repolish, settle_all
 from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
 from lynxplan.robots.ik.pose_kernel import (
     SLOT_COLUMNS,
+    new_pose_scratch,
     polish_pose,
     smallest_error,
     solve_target,
     write_slots,
 )
+from lynxplan.robots.results import BranchSlots
 
 __all__ = ["BLOCK", "pose_block_kernel"]
 
@@ -91,11 +93,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     axes: np.ndarray,
     targets: np.ndarray,
     reference: np.ndarray,
-    q_out: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    position_error: np.ndarray,
-    orientation_error: np.ndarray,
+    slots: BranchSlots,
     solved: np.ndarray,
     distance: np.ndarray,
 ) -> int:
@@ -108,14 +106,13 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     error over the slots [m].
     """
     wide_vectors()
-    nb = q_out.shape[1]
+    nb = slots.q.shape[1]
     per_side = nb // 2
     ch = chain_tuple(placements, axes)
     parallel = parallel_pitches(ch)
     pr: Floats = to_fixed_tuple(prm, N_PARAMS)  # type: ignore[call-arg]
     exact = prm[F.EXACT] != 0.0
     on_roll_axis = prm[F.OFF_AXIS] == 0.0
-    lower, upper, tol = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5], prm[F.LIMIT_TOL]
     shape = link_shape(prm)
     # the scratch rows and the candidate rows in one array (constant distances: ``closed_forms``)
     x_flat = np.zeros(POSE.rows * BLOCK + CANDIDATE.rows * CANDIDATE_WIDTH)
@@ -129,9 +126,10 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     lane_of = np.empty(4 * BLOCK, dtype=np.int64)  # lane_of[4 * i : 4 * i + owned[i]]
     slot_of = np.empty(CANDIDATE_WIDTH, dtype=np.int64)
     out = np.empty((nb, SLOT_COLUMNS))
-    g, pose, work = np.empty((3, 4)), np.empty((4, 4)), np.empty((4, 4))
-    qs, jac, origins = np.empty(5), np.empty((6, 5)), np.empty((5, 6))
-    normal, vectors = np.empty((7, 5)), np.empty((3, 6))
+    scratch = new_pose_scratch()
+    pose, qs = scratch.pose, scratch.q
+    q_out, valid, within = slots.q, slots.valid, slots.within
+    position_error, orientation_error = slots.position_error, slots.orientation_error
     taken = np.empty((4, 5))
     # the outputs flat: every slot of a block is emptied by contiguous loops (vector stores)
     q_flat, valid_flat, within_flat = q_out.reshape(-1), valid.reshape(-1), within.reshape(-1)
@@ -284,12 +282,9 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                         qs[j] = c[CANDIDATE.start + j, k]
                     current = False
                     if not exact:
-                        current = polish_pose(
-                            placements, axes, targets[n], qs, pose, work, jac, origins, normal,
-                            vectors,
-                        )  # fmt: skip
+                        current = polish_pose(placements, axes, targets[n], qs, scratch)
                     inside, err = settle(
-                        placements, axes, lower, upper, tol, targets[n], qs, pose, work, current
+                        prm, placements, axes, targets[n], qs, pose, scratch.work, current
                     )
                     angle = rotation_angle(targets[n], pose)
                     if not (err <= POSE_EXACT and angle <= POSE_EXACT):
@@ -322,9 +317,6 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
     for d in range(deferred_count):
         n = deferred[d]
         ref = reference[n if reference.shape[0] > 1 else 0]
-        solved[n] = solve_target(
-            prm, placements, axes, targets[n], ref, out,
-            g, pose, work, qs, jac, origins, normal, vectors,
-        )  # fmt: skip
-        write_slots(out, n, q_out, valid, within, position_error, orientation_error, distance)
+        solved[n] = solve_target(prm, placements, axes, targets[n], ref, out, scratch)
+        write_slots(out, n, slots, distance)
     return fallbacks + deferred_count

@@ -20,6 +20,7 @@ off-axis tool: the flip is the roll's index, ``per_side`` = 4). Angles in [rad],
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 import numba
 import numpy as np
@@ -40,6 +41,7 @@ from lynxplan.robots.ik.family_polish import (
     rotation_angle,
     settle,
 )
+from lynxplan.robots.results import BranchSlots
 
 #: The yaw one side of the lateral offset gives must match the orientation's within this [rad],
 #: plus YAW_MATCH_LENGTH / (distance from the yaw axis) (the ideal model's tool point differs
@@ -85,18 +87,49 @@ NEWTON_STEPS = 60
 MIN_FALL = 2.0
 
 
+class PoseScratch(NamedTuple):
+    """Work arrays of one full-pose solve (``solve_target``, ``polish_pose``)."""
+
+    g: np.ndarray
+    """(3, 4): the target's rotation in the family frame and its point."""
+    pose: np.ndarray
+    """(4, 4): the exact chain's pose at q."""
+    work: np.ndarray
+    """(4, 4): FK scratch."""
+    q: np.ndarray
+    """(5,) [rad]: the branch being solved."""
+    jac: np.ndarray
+    """(6, 5): the geometric Jacobian."""
+    origins: np.ndarray
+    """(5, 6): the joint axes' origins and directions."""
+    normal: np.ndarray
+    """(7, 5): J^T J, its LU row order, J^T e."""
+    vectors: np.ndarray
+    """(3, 6): the error, the step, the q before it."""
+
+
+@numba.njit(cache=True, nogil=True)
+def new_pose_scratch() -> PoseScratch:
+    """Fresh (uninitialised) work arrays of one full-pose solve."""
+    return PoseScratch(
+        np.empty((3, 4)),
+        np.empty((4, 4)),
+        np.empty((4, 4)),
+        np.empty(5),
+        np.empty((6, 5)),
+        np.empty((5, 6)),
+        np.empty((7, 5)),
+        np.empty((3, 6)),
+    )
+
+
 @numba.njit(cache=True, nogil=True)
 def polish_pose(  # noqa: PLR0912 (numba: one compiled loop)
     placements: np.ndarray,
     axes: np.ndarray,
     target: np.ndarray,
     q: np.ndarray,
-    pose: np.ndarray,
-    work: np.ndarray,
-    jac: np.ndarray,
-    origins: np.ndarray,
-    normal: np.ndarray,
-    vectors: np.ndarray,
+    scratch: PoseScratch,
 ) -> bool:
     """Gauss-Newton on the pose error of the exact chain, from a closed-form branch of the
     nearly identical ideal model (~1e-6 away): position error [m] and the rotation vector
@@ -110,10 +143,12 @@ def polish_pose(  # noqa: PLR0912 (numba: one compiled loop)
     a Jacobian; after a chord step that stalls, Newton steps from the better of the two q, and
     the polish stops when a Newton step stalls.
 
-    Scratch: pose, work (4, 4); jac (6, 5); origins (5, 6); normal (7, 5): J^T J, its LU row
-    order, and J^T e; vectors (3, 6): the error, the step and the q before it. Returns whether
-    pose holds the exact chain's pose at the final q (False after an undone step).
+    Scratch (:class:`PoseScratch`): pose, work, jac, origins, normal (J^T J, its LU row order,
+    and J^T e), vectors (the error, the step and the q before it). Returns whether
+    scratch.pose holds the exact chain's pose at the final q (False after an undone step).
     """
+    pose, work, jac = scratch.pose, scratch.work, scratch.jac
+    origins, normal, vectors = scratch.origins, scratch.normal, scratch.vectors
     previous = math.inf
     factored = False  # normal holds the factors of J^T J of the last fresh Jacobian in jac
     chord = True  # until a chord step stalls; then Newton to the end
@@ -191,25 +226,16 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
     target: np.ndarray,
     ref: np.ndarray,
     out: np.ndarray,
-    g: np.ndarray,
-    pose: np.ndarray,
-    work: np.ndarray,
-    q: np.ndarray,
-    jac: np.ndarray,
-    origins: np.ndarray,
-    normal: np.ndarray,
-    vectors: np.ndarray,
+    scratch: PoseScratch,
 ) -> bool:
     """The exact branches of one full pose (4, 4) where the orientation gives the roll, into
     the slot table out (B, SLOT_COLUMNS) (every slot written; NaN / 0 where no branch); ref (5,)
-    [rad]. Returns whether an exact branch was found (the target is complete). The rest:
-    scratch, g (3, 4), pose and work (4, 4), q (5,), jac (6, 5), origins (5, 6), normal (7, 5),
-    vectors (3, 6).
+    [rad]. Returns whether an exact branch was found (the target is complete). scratch: work
+    arrays (:class:`PoseScratch`).
     """
+    g, pose, q = scratch.g, scratch.pose, scratch.q
     nb = out.shape[0]
     per_side = nb // 2
-    lower, upper = prm[F.LOWER : F.LOWER + 5], prm[F.UPPER : F.UPPER + 5]
-    tol = prm[F.LIMIT_TOL]
     rt0 = prm[F.RT0 : F.RT0 + 9]
     exact_model = prm[F.EXACT] != 0.0
     for b in range(nb):
@@ -272,12 +298,8 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                     continue
                 current = False
                 if not exact_model:
-                    current = polish_pose(
-                        placements, axes, target, q, pose, work, jac, origins, normal, vectors
-                    )
-                inside, err = settle(
-                    placements, axes, lower, upper, tol, target, q, pose, work, current
-                )
+                    current = polish_pose(placements, axes, target, q, scratch)
+                inside, err = settle(prm, placements, axes, target, q, pose, scratch.work, current)
                 angle = rotation_angle(target, pose)
                 if not (err <= POSE_EXACT and angle <= POSE_EXACT):
                     continue
@@ -335,22 +357,7 @@ def pose_one(
     if not _is_rigid(target):
         return 0
     out = np.empty((slots, SLOT_COLUMNS))
-    solved = solve_target(
-        prm,
-        placements,
-        axes,
-        target,
-        ref,
-        out,
-        np.empty((3, 4)),
-        np.empty((4, 4)),
-        np.empty((4, 4)),
-        np.empty(5),
-        np.empty((6, 5)),
-        np.empty((5, 6)),
-        np.empty((7, 5)),
-        np.empty((3, 6)),
-    )
+    solved = solve_target(prm, placements, axes, target, ref, out, new_pose_scratch())
     if not solved:
         return 0
     k = 0
@@ -378,18 +385,11 @@ def smallest_error(errors: np.ndarray, n: int) -> float:
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def write_slots(
-    out: np.ndarray,
-    n: int,
-    q_out: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    position_error: np.ndarray,
-    orientation_error: np.ndarray,
-    distance: np.ndarray,
-) -> None:
+def write_slots(out: np.ndarray, n: int, slots: BranchSlots, distance: np.ndarray) -> None:
     """Target n's slots from :func:`solve_target`'s rows ``out`` (B, SLOT_COLUMNS) into the
     batch outputs (see :func:`pose_kernel`), and its smallest position error."""
+    q_out, valid, within = slots.q, slots.valid, slots.within
+    position_error, orientation_error = slots.position_error, slots.orientation_error
     for b in range(q_out.shape[1]):
         for j in range(5):
             q_out[n, b, j] = out[b, j]
@@ -407,11 +407,7 @@ def pose_kernel(
     axes: np.ndarray,
     targets: np.ndarray,
     reference: np.ndarray,
-    q_out: np.ndarray,
-    valid: np.ndarray,
-    within: np.ndarray,
-    position_error: np.ndarray,
-    orientation_error: np.ndarray,
+    slots: BranchSlots,
     solved: np.ndarray,
     distance: np.ndarray,
 ) -> None:
@@ -421,35 +417,15 @@ def pose_kernel(
         prm, placements, axes: Packed family parameters and the exact chain.
         targets: (N, 4, 4) target poses.
         reference: (N, 5) or (1, 5) joint angles [rad] (the yaw kept on the base axis).
-        q_out, valid, within, position_error, orientation_error: (N, B, ...) outputs in the
-            kernel's layout; every slot of every target is written.
+        slots: (N, B, ...) outputs in the kernel's layout (:class:`BranchSlots`); every slot
+            of every target is written.
         solved: (N,) output: True where an exact branch was found (the target is complete).
         distance: (N,) output: each target's smallest position error over its slots [m]
             (``smallest_error``).
     """
-    nb = q_out.shape[1]
-    out = np.empty((nb, SLOT_COLUMNS))
-    g = np.empty((3, 4))
-    pose, work = np.empty((4, 4)), np.empty((4, 4))
-    q = np.empty(5)
-    jac, origins, normal = np.empty((6, 5)), np.empty((5, 6)), np.empty((7, 5))
-    vectors = np.empty((3, 6))
+    out = np.empty((slots.q.shape[1], SLOT_COLUMNS))
+    scratch = new_pose_scratch()
     for n in range(targets.shape[0]):
         ref = reference[n if reference.shape[0] > 1 else 0]
-        solved[n] = solve_target(
-            prm,
-            placements,
-            axes,
-            targets[n],
-            ref,
-            out,
-            g,
-            pose,
-            work,
-            q,
-            jac,
-            origins,
-            normal,
-            vectors,
-        )
-        write_slots(out, n, q_out, valid, within, position_error, orientation_error, distance)
+        solved[n] = solve_target(prm, placements, axes, targets[n], ref, out, scratch)
+        write_slots(out, n, slots, distance)

@@ -11,16 +11,13 @@ hide in its cells). Without a root, the roll that comes nearest is used. Angles 
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import numba
 import numpy as np
-from numba.extending import overload
 
 from lynxplan.constants import (
     BOUNDARY_TOLERANCE,
     CLAMPED_ROOT_TOLERANCE,
-    EXACT_ROOT_STEP,
     TANGENT_TOLERANCE,
 )
 from lynxplan.robots import family as F  # noqa: N812
@@ -36,6 +33,7 @@ from lynxplan.robots.ik.roll_equation import (
     roll_mismatch,
     roll_terms,
 )
+from lynxplan.robots.ik.root_finding import equation, minimise, refine_root, simple_crossing
 
 #: Uniform cells over the roll range on which the roots of the roll equation are bracketed.
 ROOT_GRID = 48
@@ -50,8 +48,6 @@ NEAR_ROOT = 5e-3
 MAX_ROOTS = 6
 #: Grid samples of one side at most (uniform points, subdivisions, boundary samples).
 GRID_SIZE = ROOT_GRID * (BOUNDARY_SAMPLES + SUBDIVISION) + 2
-#: Brent's minimisation: relative and absolute tolerance on the minimiser [rad].
-_BRENT_RELATIVE, _BRENT_ABSOLUTE = 1.5e-8, 1e-11
 #: A model only close to the family: where the ideal equation is below this many times the
 #: model's deviation (times 1 + d / rho, d the target's distance from the shoulder, rho the
 #: wrist circle's radius), the roots are searched on the exact chain (``exact_roll_equation.py``).
@@ -59,131 +55,6 @@ EXACT_BAND = 16.0
 #: Roots of the two elbows' exact equations closer than this are one root [rad] (each elbow's
 #: branch is then polished from it).
 ROOT_MERGE = 1e-6
-
-
-def equation(problem: RollProblem | ExactProblem, theta: float) -> float:
-    """The roll equation at theta: the ideal one (``RollProblem``) or the exact chain's
-    (``ExactProblem``). Compiled code calls the overload below."""
-    if len(problem) == 7:
-        return float(roll_equation(problem, theta))
-    return float(exact_roll_equation(problem, theta))
-
-
-@overload(equation)
-def _equation_overload(problem: Any, theta: Any) -> Any:
-    # the implementations repeat the overload's signature, annotations included (numba checks)
-    if len(problem.types) == 7:
-
-        def ideal(problem: Any, theta: Any) -> Any:
-            return roll_equation(problem, theta)
-
-        return ideal
-
-    def exact(problem: Any, theta: Any) -> Any:
-        return exact_roll_equation(problem, theta)
-
-    return exact
-
-
-@numba.njit(cache=True, nogil=True)
-def _refine_root(
-    problem: RollProblem | ExactProblem,
-    a: float,
-    fa: float,
-    b: float,
-    fb: float,
-) -> float:
-    """Illinois regula falsi on a bracket [a, b] with fa * fb < 0: to the last bit on the
-    ideal equation, to EXACT_ROOT_STEP on the exact one (Newton's method on the exact chain
-    finishes its roots)."""
-    xtol = 0.0 if len(problem) == 7 else EXACT_ROOT_STEP
-    side_kept = 0
-    previous = np.inf
-    for _ in range(80):
-        c = (a * fb - b * fa) / (fb - fa)
-        if not (min(a, b) <= c <= max(a, b)):
-            c = 0.5 * (a + b)
-        fc = equation(problem, c)
-        if fc == 0.0 or abs(b - a) < 1e-15 or abs(c - previous) < xtol:
-            return c
-        previous = c
-        if (fc > 0) == (fb > 0):
-            b, fb = c, fc
-            if side_kept == -1:
-                fa *= 0.5
-            side_kept = -1
-        else:
-            a, fa = c, fc
-            if side_kept == 1:
-                fb *= 0.5
-            side_kept = 1
-        if abs(b - a) < 4e-16 * (1.0 + abs(c)):
-            return c
-    return (a * fb - b * fa) / (fb - fa)
-
-
-@numba.njit(cache=True, nogil=True)
-def _minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
-    problem: RollProblem | ExactProblem,
-    a: float,
-    b: float,
-    sign: float,
-) -> float:
-    """Minimiser of sign * f on [a, b] (Brent's method: parabolic steps, golden-section
-    fallback), or the first point found where sign * f < 0 (then f changes sign in [a, b])."""
-    golden = 0.5 * (3.0 - math.sqrt(5.0))
-    x = w = v = a + golden * (b - a)
-    fx = sign * equation(problem, x)
-    if fx < 0.0:
-        return x
-    fw = fv = fx
-    d = e = 0.0
-    for _ in range(100):
-        xm = 0.5 * (a + b)
-        tol1 = _BRENT_RELATIVE * abs(x) + _BRENT_ABSOLUTE
-        tol2 = 2.0 * tol1
-        if abs(x - xm) <= tol2 - 0.5 * (b - a):
-            break
-        parabolic = False
-        if abs(e) > tol1:
-            r = (x - w) * (fx - fv)
-            q = (x - v) * (fx - fw)
-            p = (x - v) * q - (x - w) * r
-            q = 2.0 * (q - r)
-            if q > 0.0:
-                p = -p
-            q = abs(q)
-            previous = e
-            e = d
-            if abs(p) < abs(0.5 * q * previous) and q * (a - x) < p < q * (b - x):
-                d = p / q
-                u = x + d
-                if u - a < tol2 or b - u < tol2:
-                    d = tol1 if xm >= x else -tol1
-                parabolic = True
-        if not parabolic:
-            e = (a - x) if x >= xm else (b - x)
-            d = golden * e
-        u = x + d if abs(d) >= tol1 else x + (tol1 if d > 0 else -tol1)
-        fu = sign * equation(problem, u)
-        if fu < 0.0:
-            return u
-        if fu <= fx:
-            if u >= x:
-                a = x
-            else:
-                b = x
-            v, fv, w, fw, x, fx = w, fw, x, fx, u, fu
-        else:
-            if u < x:
-                a = u
-            else:
-                b = u
-            if fu <= fw or w == x:
-                v, fv, w, fw = w, fw, u, fu
-            elif fu <= fv or (v - x) * (v - w) == 0.0:  # v is x or w
-                v, fv = u, fu
-    return x
 
 
 @numba.njit(cache=True, nogil=True)
@@ -280,28 +151,26 @@ def roll_candidates(
     """
     near = problem[0][F.EXACT] == 0.0
     # int64 and np.bool_, not literals: numba compiles a callee once per literal value
-    return _scan(
-        problem, problem, xs, fs, m, roots, np.int64(0), near, np.bool_(True), np.bool_(True)
-    )
+    ends = (np.bool_(True), np.bool_(True))
+    return _scan(problem, problem, (xs, fs, m), roots, np.int64(0), near, ends)
 
 
 @numba.njit(cache=True, nogil=True)
 def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
     problem: RollProblem | ExactProblem,
     ideal: RollProblem,
-    xs: np.ndarray,
-    fs: np.ndarray,
-    m: int,
+    samples: tuple[np.ndarray, np.ndarray, int],
     roots: np.ndarray,
     count: int,
     near_roots: bool | np.bool_,
-    lo_end: bool | np.bool_,
-    hi_end: bool | np.bool_,
+    ends: tuple[bool | np.bool_, bool | np.bool_],
 ) -> int:
-    """The roots of problem's equation sampled at xs[: m + 1] (fs; NaN where undefined) added to
-    roots[:count]; returns the new count. ``near_roots``: a near root of the ideal equation
-    gives two tentative roots; ``lo_end``, ``hi_end``: xs[0], xs[m] are ends of the roll range
-    (an extremum there hides roots)."""
+    """The roots of problem's equation sampled at xs[: m + 1] (fs; NaN where undefined;
+    ``samples``: (xs, fs, m)) added to roots[:count]; returns the new count. ``near_roots``: a
+    near root of the ideal equation gives two tentative roots; ``ends``: whether xs[0], xs[m]
+    are ends of the roll range (an extremum there hides roots)."""
+    xs, fs, m = samples
+    lo_end, hi_end = ends
     for i in range(m + 1):
         if count >= MAX_ROOTS:
             break
@@ -314,7 +183,7 @@ def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
         if not (math.isfinite(f0) and math.isfinite(f1)):
             continue
         if f1 != 0.0 and (f0 < 0.0) != (f1 < 0.0):
-            x = _refine_root(problem, xs[i], f0, xs[i + 1], f1)
+            x = refine_root(problem, xs[i], f0, xs[i + 1], f1)
             count = _keep_root(ideal, x, roots, count)
         elif (
             i > 0
@@ -325,7 +194,7 @@ def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
         ):
             # local extremum of |f| at grid point i: two roots may hide in [x_{i-1}, x_{i+1}]
             sign = 1.0 if f0 > 0 else -1.0
-            xm = _minimise(problem, xs[i - 1], xs[i + 1], sign)
+            xm = minimise(problem, xs[i - 1], xs[i + 1], sign)
             fm = equation(problem, xm)
             if fm == 0.0:
                 count = _keep_root(ideal, xm, roots, count)
@@ -341,9 +210,9 @@ def _scan(  # noqa: PLR0912 (numba kernel: one compiled scan)
                     if count > before:
                         roots[MAX_ROOTS + count - 1] = 1.0
             elif (fm < 0.0) != (f0 < 0.0) and count + 2 <= MAX_ROOTS:
-                x = _refine_root(problem, xs[i - 1], fs[i - 1], xm, fm)
+                x = refine_root(problem, xs[i - 1], fs[i - 1], xm, fm)
                 count = _keep_root(ideal, x, roots, count)
-                x = _refine_root(problem, xm, fm, xs[i + 1], f1)
+                x = refine_root(problem, xm, fm, xs[i + 1], f1)
                 count = _keep_root(ideal, x, roots, count)
     # an extremum at either end of the range hides roots the scan above cannot see
     if lo_end and m > 0:
@@ -376,12 +245,12 @@ def _end_roots(
         and abs(fs[end]) < abs(fs[inner])
     ):
         sign = 1.0 if fs[end] > 0 else -1.0
-        xm = _minimise(problem, xs[a], xs[b], sign)
+        xm = minimise(problem, xs[a], xs[b], sign)
         fm = equation(problem, xm)
         if fm != 0.0 and (fm < 0.0) != (fs[end] < 0.0):
-            x = _refine_root(problem, xs[a], fs[a], xm, fm)
+            x = refine_root(problem, xs[a], fs[a], xm, fm)
             count = _keep_root(ideal, x, roots, count)
-            x = _refine_root(problem, xm, fm, xs[b], fs[b])
+            x = refine_root(problem, xm, fm, xs[b], fs[b])
             count = _keep_root(ideal, x, roots, count)
         elif abs(fm) <= TANGENT_TOLERANCE:
             count = _keep_root(ideal, xm, roots, count)
@@ -396,11 +265,10 @@ def _exact_samples(
     lo: int,
     hi: int,
     band: float,
-    ys: np.ndarray,
-    es: np.ndarray,
-    edges: np.ndarray,
+    out: tuple[np.ndarray, np.ndarray, np.ndarray],
 ) -> int:
-    """The exact equation at the samples xs[lo : hi + 1] where it is defined, into ys, es;
+    """The exact equation at the samples xs[lo : hi + 1] where it is defined, into ys, es
+    (``out``: ys, es, edges);
     returns the index of the last (-1 if none). edges[k] is the index of the defined neighbour
     of a sample at a reach boundary, else -1.
 
@@ -409,6 +277,7 @@ def _exact_samples(
     sample at the reach boundary is added (``_reach_boundary``), so that a root between it and
     the nearest defined sample is bracketed.
     """
+    ys, es, edges = out
     n = -1
     last = lo - 1  # the last defined sample
     for s in range(lo, hi + 1):
@@ -474,7 +343,7 @@ def _reach_boundary(
 
 
 @numba.njit(cache=True, nogil=True)
-def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
+def exact_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan)
     problem: RollProblem,
     elbow0: ExactProblem,
     elbow1: ExactProblem,
@@ -517,7 +386,7 @@ def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
             j += 1
         lo, hi = max(i - 1, 0), min(j + 1, m)
         i = j + 1
-        if _simple_crossing(fs, lo, hi, m):
+        if simple_crossing(fs, lo, hi, m):
             continue  # one well-conditioned root: the ideal one, polished on the exact chain
         kept = dropped = np.int64(0)  # the ideal roots of the stretch: set aside, tried last
         for r in range(count):
@@ -530,22 +399,12 @@ def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
         count = kept
         start = count
         for exact in (elbow0, elbow1):
-            n = _exact_samples(exact, xs, fs, lo, hi, band, ys, es, edges)
+            n = _exact_samples(exact, xs, fs, lo, hi, band, (ys, es, edges))
             if n < 1:
                 continue
             before = count
-            count = _scan(
-                exact,
-                problem,
-                ys,
-                es,
-                n,
-                roots,
-                count,
-                np.bool_(False),
-                ys[0] == xs[0],
-                ys[n] == xs[m],
-            )
+            ends = (ys[0] == xs[0], ys[n] == xs[m])
+            count = _scan(exact, problem, (ys, es, n), roots, count, np.bool_(False), ends)
             for k in range(n + 1):
                 if edges[k] >= 0:
                     count = _end_roots(exact, problem, ys, es, k, edges[k], roots, count)
@@ -566,20 +425,6 @@ def exact_candidates(  # noqa: PLR0912 (numba kernel: one compiled scan)
             if count > before:
                 roots[MAX_ROOTS + count - 1] = 1.0
     return count
-
-
-@numba.njit(cache=True, nogil=True)
-def _simple_crossing(fs: np.ndarray, lo: int, hi: int, m: int) -> bool:
-    """Whether the samples fs[lo : hi + 1] are strictly monotone with one sign change, away from
-    the ends of the range [0, m]: then the exact equation, within the band of the ideal one,
-    has the one root the ideal equation has, next to it."""
-    if lo == 0 or hi == m:
-        return False
-    rising = fs[hi] > fs[lo]
-    for k in range(lo, hi):
-        if not ((fs[k + 1] > fs[k]) == rising and fs[k + 1] != fs[k]):
-            return False
-    return bool((fs[lo] < 0.0) != (fs[hi] < 0.0))
 
 
 @numba.njit(cache=True, nogil=True)
