@@ -43,12 +43,13 @@ from lynxplan.planning.kernel_model import (
 )
 from lynxplan.planning.motion import (
     copy_row,
+    pair_bound_at,
     pose_pair_at,
     reach_step,
     span_motion,
     two_sided_step,
 )
-from lynxplan.planning.pair_bound import all_pair_bounds, pair_bound
+from lynxplan.planning.pair_bound import all_pair_bounds
 from lynxplan.planning.sphere_gaps import (
     SPHERE_GRID,
     grid_clear,
@@ -65,15 +66,6 @@ from lynxplan.planning.validity import (
 
 #: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.
 MIN_STEP = 1e-4
-
-
-@numba.njit(cache=True, inline="always")
-def _bound_at(
-    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
-) -> float:
-    """Pair p's tight bound at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch.arms[side]."""
-    pose_pair_at(q_a, q_b, s, p, model, scratch, side)
-    return float(pair_bound(p, model, scratch))
 
 
 @njit_refcounted()
@@ -138,7 +130,7 @@ def _chain(
         one = reach_step(b, p, arms, 0, model, scratch)
         t = min(1.0, s + two_sided_step(b, one, trend))
         while True:  # halve the step until the two-sided test passes (one inlined bound)
-            bt = _bound_at(q_a, q_b, t, p, model, scratch, 1)
+            bt = pair_bound_at(q_a, q_b, t, p, model, scratch, 1)
             span = span_motion(p, t - s, model, scratch)
             if b + bt > span or t - s < MIN_STEP:
                 break

@@ -44,24 +44,11 @@ from lynxplan.planning.motion import (
     copy_row,
     farthest_lane,
     lever_arms,
+    pair_bound_at,
     place_lanes,
-    pose_pair_at,
     reach_step,
-    span_motion,
-    two_sided_step,
 )
-from lynxplan.planning.pair_bound import all_pair_bounds, pair_bound
-
-
-@numba.njit(cache=True, inline="always")
-def _pair_at(
-    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
-) -> float:
-    """Bound of pair p at q_a + s (q_b - q_a), in [m]; its lever arms -> scratch.arms[side]."""
-    pose_pair_at(q_a, q_b, s, p, model, scratch, side)
-    scratch.counters[1] += 1
-    scratch.counters[2] += 1
-    return float(pair_bound(p, model, scratch))
+from lynxplan.planning.pair_bound import all_pair_bounds
 
 
 @njit_no_refcount()
@@ -343,36 +330,6 @@ def _lane_run(
 
 
 @njit_no_refcount()
-def _two_sided_step(
-    q_a: np.ndarray,
-    q_b: np.ndarray,
-    p: int,
-    s: float,
-    t: float,
-    model: Any,
-    scratch: Any,
-    clearance: float,
-) -> bool:
-    """The scalar walk's two-sided step of pair p from s to t (models with too many joints
-    for the lanes): certified when its slack at t exceeds :data:`STALL_DISTANCE` and the two
-    ends' slacks its motion bound (:func:`span_motion`); the pair's state then moves to t.
-    A compiled call, not inlined: a walk with lanes never comes here, and each inlined copy of
-    the pose code lengthens :func:`edge_walk`'s first compile."""
-    slack, reach, where = scratch.slack, scratch.reach, scratch.where
-    all_arms, trend = scratch.all_arms, scratch.trend
-    slack_t = _pair_at(q_a, q_b, t, p, model, scratch, 1) - clearance
-    if not (
-        slack_t > STALL_DISTANCE and slack[p] + slack_t > span_motion(p, t - s, model, scratch)
-    ):
-        return False
-    trend[p] = (slack_t - slack[p]) / (t - s)
-    where[p], slack[p] = t, slack_t
-    copy_row(all_arms, p, scratch.arms, 1)
-    reach[p] = t + reach_step(slack_t, p, all_arms, p, model, scratch)
-    return True
-
-
-@njit_no_refcount()
 def edge_walk(
     q_a: np.ndarray,
     q_b: np.ndarray,
@@ -425,9 +382,7 @@ def edge_walk(
         if nearest >= tail[p]:  # the grid certifies the rest of the edge
             reach[p] = np.inf
             continue
-        s = where[p]
-        one = nearest - s
-        span = two_sided_step(slack[p], one, trend[p])
+        one = nearest - where[p]
         copy_row(arms, 0, all_arms, p)
         if lanes:
             run = _lane_run(q_a, q_b, p, nearest, model, scratch, clearance)
@@ -436,11 +391,9 @@ def edge_walk(
             if run < 0.0:  # blocked within the one-sided reach: the edge is certified to -run
                 counters[3] = p
                 return -run
-        if not lanes and span > 1.2 * one:  # (the lanes' first point was this one)
-            t = min(1.0, s + span)
-            if _two_sided_step(q_a, q_b, p, s, t, model, scratch, clearance):
-                continue
-        slack_t = _pair_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
+        slack_t = pair_bound_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
+        counters[1] += 1
+        counters[2] += 1
         if slack_t <= STALL_DISTANCE:
             counters[3] = p
             return nearest

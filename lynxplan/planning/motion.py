@@ -25,8 +25,9 @@ import numba
 import numpy as np
 
 from lynxplan.planning.bounds import joint_poses_upto, primitive_pose
-from lynxplan.planning.kernel_model import LANES
+from lynxplan.planning.kernel_model import LANES, njit_no_refcount
 from lynxplan.planning.lanes import OUT_ARMS, OUT_S
+from lynxplan.planning.pair_bound import pair_bound
 
 
 @numba.njit(cache=True, inline="always")
@@ -108,7 +109,7 @@ def span_motion(p: int, ds: float, model: Any, scratch: Any) -> float:
     return total * ds
 
 
-@numba.njit(cache=True, inline="always")
+@njit_no_refcount()
 def pose_pair_at(
     q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
 ) -> None:
@@ -125,6 +126,16 @@ def pose_pair_at(
     if pairs[p, 2] == 1:
         primitive_pose(pairs[p, 1], model, scratch)
     lever_arms(p, scratch.joint_poses, scratch.prim_poses, model, scratch.arms, side)
+
+
+@njit_no_refcount()
+def pair_bound_at(
+    q_a: np.ndarray, q_b: np.ndarray, s: float, p: int, model: Any, scratch: Any, side: int
+) -> float:
+    """Pair p's bound at q_a + s (q_b - q_a), in [m] (:func:`lynxplan.planning.pair_bound.
+    pair_bound`); its lever arms -> scratch.arms[side]."""
+    pose_pair_at(q_a, q_b, s, p, model, scratch, side)
+    return float(pair_bound(p, model, scratch))
 
 
 #: A walk tries a two-sided step of this many one-sided steps (the two-sided test allows < 2).

@@ -72,7 +72,7 @@ def _spheres_to_box(
     return gap
 
 
-@numba.njit(cache=True, inline="always")
+@njit_no_refcount()
 def sphere_gap(p: int, model: Any, scratch: Any) -> float:
     """Covering-sphere lower bound of pair p's distance at the poses in scratch.prim_poses, in [m].
 
