@@ -15,7 +15,7 @@ from starlette.responses import HTMLResponse, Response
 from starlette.types import ASGIApp
 
 from lynxplan import __version__
-from lynxplan.service import compute, wire
+from lynxplan.service import kinematics_tasks, wire
 from lynxplan.service.auth import Guard
 from lynxplan.service.config import ServiceConfig
 from lynxplan.service.fastpath import FastPath
@@ -44,7 +44,7 @@ def create_app(config: ServiceConfig) -> ASGIApp:
             memory_limit=config.run_memory, dask_scheduler=config.dask_scheduler,
         )  # fmt: skip
         get_robot("al5")  # load the model (and JIT caches) before the first request
-        compute.ik_batch_arrays(np.eye(4)[None])
+        kinematics_tasks.ik_batch_arrays(np.eye(4)[None])
         compute_pool.start()  # warm in the background: /health answers meanwhile
         yield
         compute_pool.close()

@@ -1,7 +1,7 @@
 """The computations behind the routes, on validated numpy arrays; no HTTP here.
 
-They are plain functions of arrays so that a Dask worker can run them too
-(:func:`ik_batch_arrays` for large batches).
+They are plain functions of arrays (the kinematics ones in :mod:`.kinematics_tasks`, whose
+``ik_batch_arrays`` a Dask worker runs for large batches).
 """
 
 from __future__ import annotations
@@ -12,72 +12,7 @@ from typing import Any
 
 import numpy as np
 
-#: Configurations cross-checked against Pinocchio's own FK in one /fk answer (a fixed subsample).
-FK_VERIFICATION_SAMPLES = 256
-
-
-def fk_arrays(arm: Any, q: np.ndarray) -> dict[str, Any]:
-    """Tool poses of ``q`` (5,) or (N, 5) [rad] and the verification residual.
-
-    Returns:
-        ``T``: (4, 4) or (N, 4, 4) in [m]; ``residual``: largest |closed form - Pinocchio| over
-        up to :data:`FK_VERIFICATION_SAMPLES` evenly spaced configurations, in [m] (unitless for
-        the rotation part).
-    """
-    T = arm.fk(q)
-    configs = q.reshape(-1, 5)
-    poses = T.reshape(-1, 4, 4)
-    picks = np.unique(
-        np.linspace(0, len(configs) - 1, min(len(configs), FK_VERIFICATION_SAMPLES)).astype(np.intp)
-    )
-    residual = max(
-        float(np.abs(arm.frame_placement(configs[i]) - poses[i]).max()) for i in picks.tolist()
-    )
-    return {"T": T, "residual": residual}
-
-
-def ik_single(
-    arm: Any, T: np.ndarray, q_reference: np.ndarray | None, select: str, approach_only: bool
-) -> tuple[Any, float]:
-    """IK of one pose (:meth:`Arm.ik`) and the tool position residual of the selected branch.
-
-    Returns:
-        The library's ``IkResult`` and ``|p_fk(q) - p_target|`` of the selected solution, in [m]
-        (the library checks every branch by forward kinematics; NaN when no branch is within
-        limits).
-    """
-    result = arm.ik(T, q_reference=q_reference, select=select, approach_only=approach_only)
-    if result.selected is None:
-        return result, float("nan")
-    return result, float(result.solutions[result.selected].position_error)
-
-
-def ik_batch_arrays(
-    T: np.ndarray,
-    q_reference: np.ndarray | None = None,
-    approach_only: bool = False,
-    verify: bool = True,
-) -> dict[str, np.ndarray]:
-    """All-branch IK of (N, 4, 4) poses with each branch's FK position residual.
-
-    Returns:
-        The fields of the library's ``IkBatch`` plus, when ``verify``, ``position_error``
-        (N, 4), in [m]: ``|p_fk(q) - p_target|`` of every branch (NaN where the pose failed).
-    """
-    from lynxplan.arm.model import load_arm
-
-    arm = load_arm()
-    batch = arm.ik_batch(T, q_reference=q_reference, approach_only=approach_only)
-    out = {name: np.asarray(getattr(batch, name)) for name in batch._fields}
-    if not verify:
-        return out
-    q = np.nan_to_num(batch.q.reshape(-1, 5), nan=0.0)  # failed poses: NaN q, error set below
-    reached = arm.fk(q)[:, :3, 3].reshape(-1, 4, 3)
-    reached -= T.reshape(-1, 4, 4)[:, None, :3, 3]
-    error = np.sqrt(np.einsum("nbi,nbi->nb", reached, reached))
-    error[np.isnan(batch.q[..., 0])] = np.nan
-    out["position_error"] = error
-    return out
+from lynxplan.service import kinematics_tasks
 
 
 def build_obstacles(specs: Sequence[Mapping[str, Any]]) -> list[Any]:
@@ -301,12 +236,15 @@ def view_task(robot: str, q: np.ndarray) -> bytes:
     return view_html(get_robot(robot), q).encode("utf-8")
 
 
-#: The computations a compute worker runs, by name.
-TASKS: dict[str, Callable[..., bytes]] = {
+#: The computations a compute worker runs, by name: each answers JSON or HTML bytes, or
+#: (content, media type, headers).
+TASKS: dict[str, Callable[..., Any]] = {
     "check": check_task,
     "trajectory": trajectory_task,
     "plan": plan_task,
     "view": view_task,
+    "fk": kinematics_tasks.fk_answer,
+    "ik": kinematics_tasks.ik_answer,
 }
 
 

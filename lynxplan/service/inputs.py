@@ -63,15 +63,21 @@ def number(body: dict[str, Any], name: str, default: float, low: float, high: fl
     return float(value)
 
 
-def reference(body: dict[str, Any], count: int | None) -> np.ndarray | None:
-    """``q_reference``: (5,) or, for a batch of ``count`` poses, (count, 5), in [rad]."""
+def reference(
+    body: dict[str, Any], count: int | None, dof: int = 5, robot: str = "al5"
+) -> np.ndarray | None:
+    """``q_reference``: (dof,) or, for a batch of ``count`` poses, (count, dof), in [rad]."""
     if body.get("q_reference") is None:
         return None
-    array = as_array(body["q_reference"], "q_reference", (5,), batch=count is not None)
+    owner = f"{robot} ({dof} joints)"
+    array = as_array(
+        body["q_reference"], "q_reference", (dof,), batch=count is not None, owner=owner
+    )
     if array.ndim == 2 and array.shape[0] != count:
         raise Problem(
             422,
-            f"q_reference must have shape (5,) or ({count}, 5). Got: {array.shape}",
+            f"q_reference must have shape ({dof},) or ({count}, {dof}) for {owner}. "
+            f"Got: {array.shape}",
             "q_reference",
         )
     return array

@@ -12,16 +12,20 @@ import numpy as np
 from fastapi import FastAPI, Request
 from starlette.responses import HTMLResponse, Response
 
-from lynxplan.service import compute, inputs, sizes, wire
+from lynxplan.service import compute, inputs, kinematics_tasks, sizes, wire
 from lynxplan.service.config import ServiceConfig
 from lynxplan.service.jobs import RunManager
 from lynxplan.service.problems import Problem
-from lynxplan.service.robots import get_robot, is_al5, robot_ik_batch_arrays
+from lynxplan.service.robots import (
+    check_robot_name,
+    get_robot,
+    ik_slots,
+    is_al5,
+    motion_robot,
+    robot_dof,
+)
 from lynxplan.service.schemas import openapi_body
 from lynxplan.service.workers import ComputePool
-
-#: Batches at least this large are solved off the event loop (or on Dask when configured).
-THREAD_BATCH = 2_000
 
 
 def add_kinematics_routes(
@@ -35,9 +39,6 @@ def add_kinematics_routes(
     """
     view_lock = asyncio.Lock()
     pool = ComputePool(config.compute_workers, config.run_memory, compute.MAX_REQUEST_TIME)
-
-    def answer_kind(request: Request) -> str:
-        return "binary" if wire.wants_binary(request) else "json"
 
     async def json_body(request: Request) -> dict[str, Any]:
         return wire.parse_json_object(await wire.read_body(request, config.max_body))
@@ -57,23 +58,25 @@ def add_kinematics_routes(
         else:
             body = await json_body(request)
             q_value = body.get("q")
-        arm = get_robot(inputs.robot_name(body))
+        name = inputs.robot_name(body)
+        check_robot_name(name)
+        dof, owner = robot_dof(name), f"{name} ({robot_dof(name)} joints)"
         if q_value is None:
-            raise Problem(422, "q is required: joint angles (5,) or (N, 5) in rad", "q")
-        q = wire.as_array(q_value, "q", (5,), limit=batch_limit(request))
+            raise Problem(422, f"q is required: joint angles ({dof},) or (N, {dof}) of {owner} "
+                          "in rad", "q")  # fmt: skip
+        q = wire.as_array(q_value, "q", (dof,), limit=batch_limit(request), owner=owner)
         count = len(q) if q.ndim == 2 else 1
-        sizes.check_answer(config, "q", count, sizes.FK_POSE_BYTES[answer_kind(request)], "poses")
-        result = await _maybe_threaded(len(q) if q.ndim == 2 else 1, compute.fk_arrays, arm, q)
-        if wire.wants_binary(request):
-            return wire.arrays_response(
-                request, {"T": result["T"]}, {"residual": result["residual"]}
-            )
-        return wire.json_response(result)
+        answer = wire.answer_format(request)
+        per_pose = sizes.FK_POSE_BYTES["json" if answer == "json" else "binary"]
+        sizes.check_answer(config, "q", count, per_pose, "poses")
+        if kinematics_tasks.fk_inline(count):
+            encoded = kinematics_tasks.fk_answer(name, q, answer)
+        else:
+            encoded = await pool.call_encoded(request, "fk", robot=name, q=q, answer=answer)
+        return wire.encoded_response(encoded)
 
     @app.post("/ik", tags=["kinematics"], openapi_extra=openapi_body("IkRequest", binary=True))
-    async def ik(
-        request: Request,
-    ) -> Response:
+    async def ik(request: Request) -> Response:
         start = time.perf_counter()
         params = request.query_params if request.scope["query_string"] else {}
         robot = params.get("robot", "al5")
@@ -89,26 +92,31 @@ def add_kinematics_routes(
         else:
             body = await json_body(request)
             T, batch, only_approach = inputs.ik_target(body, config.max_json_batch)
-        arm = get_robot(inputs.robot_name(body))
-        if not batch:
-            select = inputs.choice(body, "select", ("nearest", "report"))
-            result, residual = compute.ik_single(
-                arm, T, inputs.reference(body, None), select, only_approach
-            )
-            return wire.json_response(_ik_single_json(result, residual))
-        reference = inputs.reference(body, len(T))
-        sizes.check_answer(config, "T", len(T), sizes.IK_POSE_BYTES[answer_kind(request)], "poses")
-        scalars: dict[str, Any] = {"count": len(T)}
-        if is_al5(arm):
-            arrays = await _ik_batch(runs(), config, T, reference, only_approach, verify)
-        else:  # SO-100, SO-101: lynxplan.robots (their branch slots named in the answer)
-            arrays, scalars["branch_names"] = await _maybe_threaded(
-                len(T), robot_ik_batch_arrays, arm, T, reference, only_approach
-            )
-        if wire.wants_binary(request):
-            response = wire.arrays_response(request, arrays, scalars)
+        name = inputs.robot_name(body)
+        arm = get_robot(name)
+        dof = robot_dof(name)
+        count = len(T) if batch else 1
+        reference = inputs.reference(body, count if batch else None, dof, name)
+        if batch:
+            answer = wire.answer_format(request)
+            slots = ik_slots(arm, only_approach)
+            per_pose = sizes.ik_pose_bytes("json" if answer == "json" else "binary", slots, dof)
+            sizes.check_answer(config, "T", count, per_pose, "poses")
+            task: dict[str, Any] = {"robot": name, "T": T, "reference": reference,
+                                    "approach_only": only_approach, "verify": verify,
+                                    "answer": answer}  # fmt: skip
         else:
-            response = wire.json_response({**scalars, **arrays})
+            select = inputs.choice(body, "select", ("nearest", "report"))
+            task = {"robot": name, "T": T, "reference": reference, "select": select,
+                    "approach_only": only_approach}  # fmt: skip
+        if kinematics_tasks.ik_inline(arm, count, only_approach):
+            encoded = (kinematics_tasks.ik_batch_answer(**task) if batch
+                       else kinematics_tasks.ik_single_answer(**task))  # fmt: skip
+        elif batch and is_al5(arm) and _dask_batch(runs(), config, count):
+            encoded = await _dask_ik(runs(), task)
+        else:
+            encoded = await pool.call_encoded(request, "ik", **task)
+        response = wire.encoded_response(encoded)
         # Server time from the first body byte to the encoded answer (RFC Server-Timing).
         response.headers["Server-Timing"] = f"app;dur={1e3 * (time.perf_counter() - start):.3f}"
         return response
@@ -118,7 +126,7 @@ def add_kinematics_routes(
     async def check(request: Request) -> Response:
         body = await json_body(request)
         name = inputs.robot_name(body)
-        get_robot(name)
+        get_robot(motion_robot(name, "/check"))
         q = wire.as_array(body.get("q"), "q", (5,), limit=config.max_json_batch)
         t = None if body.get("t") is None else wire.as_array(body["t"], "t", (), batch=True)
         if t is not None and t.shape != (len(q.reshape(-1, 5)),):
@@ -134,7 +142,7 @@ def add_kinematics_routes(
     async def trajectory(request: Request) -> Response:
         body = await json_body(request)
         name = inputs.robot_name(body)
-        arm = get_robot(name)
+        arm = get_robot(motion_robot(name, "/trajectory"))
         waypoints = wire.as_array(body.get("waypoints"), "waypoints", (5,), limit=1000)
         if waypoints.ndim != 2 or len(waypoints) < 2:
             raise Problem(
@@ -156,7 +164,7 @@ def add_kinematics_routes(
     async def plan(request: Request) -> Response:
         body = await json_body(request)
         name = inputs.robot_name(body)
-        arm = get_robot(name)
+        arm = get_robot(motion_robot(name, "/plan"))
         start = wire.as_array(body.get("start"), "start", (5,), batch=False)
         goal_value = body.get("goal")
         goal_shape = (4, 4) if isinstance(goal_value, list) and goal_value and isinstance(
@@ -179,7 +187,7 @@ def add_kinematics_routes(
     async def view(request: Request) -> Response:
         body = await json_body(request)
         name = inputs.robot_name(body)
-        get_robot(name)
+        get_robot(motion_robot(name, "/view"))
         q = wire.as_array(body.get("q"), "q", (5,), batch=False)
         async with view_lock:  # one meshcat server process at a time
             html = await pool.call(request, "view", robot=name, q=q)
@@ -242,44 +250,28 @@ def _check_plan_samples(
     sizes.check_samples(config, count, values, defaults, "options.sample_rate")
 
 
-async def _maybe_threaded(count: int, function: Any, *args: Any) -> Any:
-    if count >= THREAD_BATCH:
-        return await asyncio.to_thread(function, *args)
-    return function(*args)
-
-
-async def _ik_batch(
-    manager: RunManager,
-    config: ServiceConfig,
-    T: np.ndarray,
-    reference: Any,
-    approach: bool,
-    verify: bool,
-) -> dict[str, np.ndarray]:
+def _dask_batch(manager: RunManager, config: ServiceConfig, count: int) -> bool:
+    """Whether an AL5 /ik batch of ``count`` poses goes to the configured Dask cluster."""
     from lynxplan.service.pools import DaskPool
 
-    if isinstance(manager.pool, DaskPool) and len(T) >= config.dask_batch:
-        future = manager.pool.client.submit(
-            compute.ik_batch_arrays, T, reference, approach, verify, pure=False
-        )
-        result: dict[str, np.ndarray] = await asyncio.to_thread(future.result)
-        return result
-    arrays: dict[str, np.ndarray] = await _maybe_threaded(
-        len(T), compute.ik_batch_arrays, T, reference, approach, verify
-    )
-    return arrays
+    return isinstance(manager.pool, DaskPool) and count >= config.dask_batch
 
 
-def _ik_single_json(result: Any, residual: float) -> dict[str, Any]:
-    selected = result.selected
-    return {
-        "q": None if selected is None else result.solutions[selected].q,
-        "selected": selected,
-        "branch": None if selected is None else result.solutions[selected].branch,
-        "orientation_residual": result.orientation_residual,
-        "position_residual": residual,
-        "solutions": [s._asdict() for s in result.solutions],
-    }
+async def _dask_ik(manager: RunManager, task: dict[str, Any]) -> wire.Encoded:
+    """An AL5 /ik batch solved on the Dask cluster (cancelled if this request is), encoded
+    off the event loop."""
+    from lynxplan.service.pools import DaskPool
+
+    assert isinstance(manager.pool, DaskPool)
+    arguments = (task["T"], task["reference"], task["approach_only"], task["verify"])
+    future = manager.pool.client.submit(kinematics_tasks.ik_batch_arrays, *arguments, pure=False)
+    try:
+        arrays: dict[str, np.ndarray] = await asyncio.to_thread(future.result)
+    except asyncio.CancelledError:
+        future.cancel()
+        raise
+    scalars = {"count": len(task["T"])}
+    return await asyncio.to_thread(wire.encode_answer, arrays, scalars, task["answer"])
 
 
 def _timing(body: dict[str, Any]) -> tuple[float, float] | None:

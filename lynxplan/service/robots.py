@@ -19,19 +19,40 @@ from lynxplan.service.problems import Problem
 NAME_ECHO = 40
 
 
-#: The built-in robots whose arm has five joints: the endpoints' arrays are (N, 5) today; the
-#: 6- and 7-joint built-ins (ur5, ur10, panda) are served through scenario runs only.
-SERVED_DOF = 5
+#: Joints of the robots served by /check, /trajectory, /plan and /view (their arrays are
+#: (N, 5)); /fk, /ik, /robots and runs serve every built-in (ur5, ur10: 6 joints; panda: 7).
+MOTION_DOF = 5
 
 
 @functools.cache
 def robot_names() -> tuple[str, ...]:
-    """Names of the robots the service serves (lynxplan's 5-joint built-ins)."""
+    """Names of the robots the service serves (lynxplan's built-ins)."""
     from lynxplan.robots import builtin_robot_names
+
+    return tuple(sorted(builtin_robot_names()))
+
+
+@functools.cache
+def robot_dof(name: str) -> int:
+    """Joints of the arm of built-in robot ``name`` (from its description, nothing loaded)."""
     from lynxplan.robots.loading import builtin_robots
 
-    specs = builtin_robots()
-    return tuple(sorted(n for n in builtin_robot_names() if specs[n].arm_joints == SERVED_DOF))
+    return int(builtin_robots()[name].arm_joints)
+
+
+def motion_robot(name: str, path: str) -> str:
+    """``name`` if it is a built-in robot of :data:`MOTION_DOF` joints, the robots ``path``
+    serves; else Problem 404 (unknown) or 422 naming ``robot``, its joints and those robots."""
+    check_robot_name(name)
+    if robot_dof(name) != MOTION_DOF:
+        served = ", ".join(n for n in robot_names() if robot_dof(n) == MOTION_DOF)
+        raise Problem(
+            422,
+            f"robot: {name} has {robot_dof(name)} joints; {path} serves the {MOTION_DOF}-joint "
+            f"robots ({served}); every robot: /fk, /ik and runs",
+            "robot",
+        )
+    return name
 
 
 def check_robot_name(name: object, field: str = "robot") -> str:
@@ -59,6 +80,25 @@ def get_robot(name: str, field: str = "robot") -> Any:
     from lynxplan.robots import load_robot
 
     return load_robot(name)
+
+
+def is_numerical(robot: Any) -> bool:
+    """Whether ``robot``'s IK is the numerical solver (outside the closed-form family): its
+    cost per pose is milliseconds, not microseconds."""
+    return not is_al5(robot) and robot.family is None
+
+
+def ik_slots(robot: Any, approach_only: bool) -> int:
+    """Branch slots per pose of ``robot``'s batch IK (``Robot.ik_batch``): 4 for the AL5 and
+    arms whose tool is on the roll axis, 8 (24 for approach targets) for an off-axis tool, 1
+    for the numerical solver."""
+    if is_al5(robot):
+        return 4
+    if robot.family is None:
+        return 1
+    if robot.family.tool_on_roll_axis:
+        return 4
+    return 24 if approach_only else 8
 
 
 def is_al5(robot: Any) -> bool:

@@ -11,18 +11,23 @@ from pydantic import BaseModel, Field
 class FkRequest(BaseModel):
     """Forward kinematics: tool pose of joint angles."""
 
-    robot: str = Field("al5", description="Robot name (GET /robots).")
-    q: list[Any] = Field(description="Joint angles, (5,) or (N, 5), in rad.")
+    robot: str = Field("al5", description="Robot name (GET /robots): any built-in robot.")
+    q: list[Any] = Field(
+        description="Joint angles, (n,) or (N, n), in rad; n: the robot's joints (al5, so100, "
+        "so101: 5; ur5, ur10: 6; panda: 7)."
+    )
 
 
 class IkRequest(BaseModel):
     """Inverse kinematics of one pose or a batch: ``T``, or ``position`` + ``approach`` (5-D)."""
 
-    robot: str = "al5"
+    robot: str = Field("al5", description="Robot name (GET /robots): any built-in robot.")
     T: list[Any] | None = Field(None, description="Tool pose (4, 4) or (N, 4, 4), in m.")
     position: list[Any] | None = Field(None, description="Tool position (3,) or (N, 3), in m.")
     approach: list[Any] | None = Field(None, description="Approach axis (3,) or (N, 3).")
-    q_reference: list[Any] | None = Field(None, description="(5,) or (N, 5), in rad.")
+    q_reference: list[Any] | None = Field(
+        None, description="(n,) or (N, n), in rad; n: the robot's joints."
+    )
     select: Literal["nearest", "report"] = "nearest"
     approach_only: bool = False
 
@@ -30,7 +35,7 @@ class IkRequest(BaseModel):
 class CheckRequest(BaseModel):
     """Joint-limit and collision check of configurations, or a trajectory when ``t`` is given."""
 
-    robot: str = "al5"
+    robot: str = Field("al5", description="A 5-joint robot: al5, so100 or so101.")
     q: list[Any] = Field(description="(5,) or (N, 5), in rad.")
     t: list[float] | None = Field(None, description="Sample times (N,), in s.")
     obstacles: list[dict[str, Any]] = Field(

@@ -24,9 +24,6 @@ from lynxplan.service.problems import Problem
 JSON_NUMBER_BYTES = 25
 #: Numbers per sample of a trajectory answer: t and q, qd, qdd of 5 joints.
 SAMPLE_NUMBERS = 16
-#: Answer bytes per pose of an ``/ik`` batch, at most (8 branches of the SO-10x: q (8, 5) and
-#: four flags or errors per branch, two per pose): binary float64, JSON.
-IK_POSE_BYTES = {"binary": 8 * 74 + 64, "json": JSON_NUMBER_BYTES * 74}
 #: Answer bytes per configuration of ``/fk`` (a 4x4 pose): binary float64, JSON.
 FK_POSE_BYTES = {"binary": 8 * 16, "json": JSON_NUMBER_BYTES * 16}
 #: Numbers per configuration of a ``/check`` answer besides one clearance per obstacle.
@@ -59,6 +56,13 @@ def check_answer(config: ServiceConfig, field: str, count: int, per_item: int, w
             f"more than the limit of {_mb(limit)}; send at most {limit // per_item} per request",
             field,
         )
+
+
+def ik_pose_bytes(answer: str, slots: int, dof: int) -> int:
+    """Answer bytes per pose of an ``/ik`` batch of ``slots`` branch slots of ``dof`` joints,
+    at most (q, four flags or errors per slot, two per pose): ``answer`` binary or json."""
+    numbers = slots * (dof + 4) + 2
+    return 8 * numbers + 64 if answer == "binary" else JSON_NUMBER_BYTES * numbers
 
 
 def check_pairs(config: ServiceConfig, configurations: int, obstacles: int) -> None:
@@ -133,11 +137,11 @@ def check_samples(
 
 __all__ = [
     "FK_POSE_BYTES",
-    "IK_POSE_BYTES",
     "MAX_CHECK_PAIRS",
     "check_answer",
     "check_pairs",
     "check_samples",
+    "ik_pose_bytes",
     "motion_samples",
     "sample_limit",
 ]

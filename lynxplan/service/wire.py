@@ -163,9 +163,17 @@ def _count(n: int) -> str:
 
 
 def as_array(
-    value: Any, field: str, trailing: tuple[int, ...], *, batch: bool = True, limit: int = 0
+    value: Any,
+    field: str,
+    trailing: tuple[int, ...],
+    *,
+    batch: bool = True,
+    limit: int = 0,
+    owner: str = "",
 ) -> np.ndarray:
     """A float64 array of shape ``trailing`` or (N, *trailing), checked with numpy.
+
+    ``owner`` (e.g. ``"ur5 (6 joints)"``) is named in a shape error after the expected shape.
 
     Raises:
         Problem: 422 for a wrong type, shape or a non-finite value; 413 for N > ``limit`` (> 0).
@@ -184,7 +192,8 @@ def as_array(
     if not single and not (
         batch and array.ndim == len(trailing) + 1 and array.shape[1:] == trailing
     ):
-        raise Problem(422, f"{field} must have shape {expected}. Got: {array.shape}", field)
+        owned = f" for {owner}" if owner else ""
+        raise Problem(422, f"{field} must have shape {expected}{owned}. Got: {array.shape}", field)
     if not single and array.shape[0] == 0:
         raise Problem(422, f"{field} is an empty batch: give at least one {trailing} entry", field)
     if limit and not single and array.shape[0] > limit:
@@ -242,16 +251,46 @@ def npy_stream_bytes(arrays: Mapping[str, np.ndarray]) -> bytes:
     return buffer.getvalue()
 
 
+#: An encoded answer: (content, media type, headers).
+Encoded = tuple[bytes, str, dict[str, str]]
+
+
+def answer_format(request: Request) -> str:
+    """The answer format the client accepts: ``"stream"`` (npy stream), ``"npz"`` or
+    ``"json"``."""
+    accept = request.headers.get("accept", "")
+    if STREAM_MEDIA_TYPE in accept:
+        return "stream"
+    return "npz" if NPZ_MEDIA_TYPE in accept else "json"
+
+
+def encode_answer(
+    arrays: Mapping[str, np.ndarray], scalars: Mapping[str, Any], answer: str
+) -> Encoded:
+    """``arrays`` and ``scalars`` in format ``answer`` (:func:`answer_format`): JSON (one
+    object), or the arrays binary (npy stream or npz) with the scalars as JSON in the
+    ``X-Result`` header and the array names in ``X-Arrays``."""
+    if answer == "json":
+        return dumps({**scalars, **arrays}), "application/json", {}
+    stream = answer == "stream"
+    content = npy_stream_bytes(arrays) if stream else npz_bytes(arrays)
+    headers = {"X-Result": orjson.dumps(scalars).decode(), "X-Arrays": ",".join(arrays)}
+    return content, STREAM_MEDIA_TYPE if stream else NPZ_MEDIA_TYPE, headers
+
+
+def encoded_response(encoded: Encoded) -> Response:
+    """The response of an :data:`Encoded` answer."""
+    content, media, headers = encoded
+    return Response(content, media_type=media, headers=headers)
+
+
 def arrays_response(
     request: Request, arrays: Mapping[str, np.ndarray], scalars: Mapping[str, Any]
 ) -> Response:
     """A binary answer in the format the client accepts (npy stream, else npz); ``scalars``
     travel as JSON in the ``X-Result`` header, the array names in ``X-Arrays``."""
-    stream = STREAM_MEDIA_TYPE in request.headers.get("accept", "")
-    content = npy_stream_bytes(arrays) if stream else npz_bytes(arrays)
-    headers = {"X-Result": orjson.dumps(scalars).decode(), "X-Arrays": ",".join(arrays)}
-    return Response(content, media_type=STREAM_MEDIA_TYPE if stream else NPZ_MEDIA_TYPE,
-                    headers=headers)  # fmt: skip
+    answer = "stream" if STREAM_MEDIA_TYPE in request.headers.get("accept", "") else "npz"
+    return encoded_response(encode_answer(arrays, scalars, answer))
 
 
 def read_arrays(data: bytes, media: str, names: str) -> dict[str, np.ndarray]:

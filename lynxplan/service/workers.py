@@ -1,5 +1,6 @@
 """The compute pool: warm worker processes that run the routes' heavier computations (``/check``,
-``/trajectory``, ``/plan``, ``/view``) outside the server process.
+``/trajectory``, ``/plan``, ``/view``, and ``/fk`` and ``/ik`` past a few milliseconds of work)
+outside the server process; large arrays and answers pass through shared memory.
 
 Each worker is bounded in memory (``RLIMIT_AS``) and each computation in time: a computation
 past its time limit, or whose client has disconnected, has its worker killed (and replaced in
@@ -13,15 +14,20 @@ from __future__ import annotations
 
 import asyncio
 import contextlib
+import mmap
 import multiprocessing
 import os
 import threading
 import time
+from dataclasses import dataclass
+from multiprocessing import reduction
 from typing import Any
 
+import numpy as np
 from starlette.requests import Request
 
 from lynxplan.service.problems import Problem
+from lynxplan.service.wire import Encoded
 
 #: Requests that may wait for a compute worker at once (each holds its decoded body).
 MAX_WAITING = 64
@@ -32,6 +38,100 @@ START_TIMEOUT = 180.0
 #: Scheduling niceness of the compute workers: their warm-up and long computations yield the
 #: cores to the server process, whose hot routes (/ik, /fk) keep their latency.
 WORKER_NICENESS = 10
+#: Arrays and answers at least this large, in [bytes], travel between the server and a worker
+#: in shared memory (a memfd whose descriptor follows the message over the worker's socket):
+#: copied once each way instead of streamed through the socket in small pieces.
+SHARE_BYTES = 1 << 20
+
+
+@dataclass(frozen=True)
+class _Shared:
+    """Stands in a message for a buffer that follows it as a memfd: an array (``dtype``,
+    ``shape``) or bytes (``dtype`` empty). (Not a tuple: an answer's payload may be one.)"""
+
+    nbytes: int
+    dtype: str
+    shape: tuple[int, ...]
+
+
+def _write_memfd(data: Any) -> int:
+    """A new memfd holding the bytes of ``data`` (a C-contiguous buffer)."""
+    fd = os.memfd_create("lynxplan-compute", os.MFD_CLOEXEC)
+    try:
+        view = memoryview(data).cast("B")
+        written = 0
+        while written < len(view):
+            written += os.write(fd, view[written:])
+    except BaseException:
+        os.close(fd)
+        raise
+    return fd
+
+
+def _send_shared(connection: Any, message: Any, buffers: list[Any]) -> None:
+    """``message``, then each of ``buffers`` as a memfd (its descriptor passed, then closed)."""
+    fds = [_write_memfd(buffer) for buffer in buffers]
+    try:
+        connection.send(message)
+        for fd in fds:
+            reduction.send_handle(connection, fd, 0)
+    finally:
+        for fd in fds:
+            os.close(fd)
+
+
+def _receive_shared(connection: Any, shared: _Shared) -> Any:
+    """The buffer ``shared`` stands for, from the memfd that follows on ``connection``: an
+    array (a private copy-on-write mapping: no copy) or bytes."""
+    fd = reduction.recv_handle(connection)
+    try:
+        if not shared.dtype:
+            with mmap.mmap(fd, shared.nbytes, prot=mmap.PROT_READ) as mapped:
+                return mapped[:]
+        mapped = mmap.mmap(fd, shared.nbytes, flags=mmap.MAP_PRIVATE,
+                           prot=mmap.PROT_READ | mmap.PROT_WRITE)  # fmt: skip
+        return np.frombuffer(mapped, dtype=shared.dtype).reshape(shared.shape)
+    finally:
+        os.close(fd)
+
+
+def _share_arrays(kwargs: dict[str, Any]) -> tuple[dict[str, Any], list[Any]]:
+    """``kwargs`` with its large arrays replaced by :class:`_Shared`, and those arrays."""
+    sent, buffers = dict(kwargs), []
+    for name, value in kwargs.items():
+        if isinstance(value, np.ndarray) and value.nbytes >= SHARE_BYTES:
+            array = np.ascontiguousarray(value)
+            sent[name] = _Shared(array.nbytes, array.dtype.str, array.shape)
+            buffers.append(array)
+    return sent, buffers
+
+
+def _receive_arrays(connection: Any, kwargs: dict[str, Any]) -> dict[str, Any]:
+    """``kwargs`` with each :class:`_Shared` replaced by its array (in message order)."""
+    return {name: _receive_shared(connection, value) if isinstance(value, _Shared) else value
+            for name, value in kwargs.items()}  # fmt: skip
+
+
+def _send_answer(connection: Any, answer: tuple[int, Any]) -> None:
+    """A task's ``(status, payload)``; a large content travels as a memfd."""
+    status, payload = answer
+    content = payload[0] if isinstance(payload, tuple) else payload
+    if status != 200 or not isinstance(content, bytes) or len(content) < SHARE_BYTES:
+        connection.send(answer)
+        return
+    marker = _Shared(len(content), "", ())
+    shared = (marker, *payload[1:]) if isinstance(payload, tuple) else marker
+    _send_shared(connection, (status, shared), [content])
+
+
+def _receive_answer(connection: Any) -> tuple[int, Any]:
+    """The worker's ``(status, payload)``, a content sent as a memfd read back."""
+    status, payload = connection.recv()
+    content = payload[0] if isinstance(payload, tuple) else payload
+    if isinstance(content, _Shared):
+        data = _receive_shared(connection, content)
+        payload = (data, *payload[1:]) if isinstance(payload, tuple) else data
+    return status, payload
 
 
 def _worker_main(connection: Any, memory_limit: int) -> None:
@@ -50,9 +150,10 @@ def _worker_main(connection: Any, memory_limit: int) -> None:
     while True:
         try:
             name, kwargs = connection.recv()
-        except (EOFError, OSError):
+            kwargs = _receive_arrays(connection, kwargs)
+        except (EOFError, OSError, RuntimeError):
             return
-        connection.send(compute.run_task(name, kwargs, memory_limit))
+        _send_answer(connection, compute.run_task(name, kwargs, memory_limit))
 
 
 def _exit_with_parent() -> None:
@@ -124,7 +225,9 @@ class _Worker:
             connection = self._connection
             if connection is None:
                 raise RuntimeError("the pool is closing")
-            connection.send(message)
+            task, kwargs = message
+            sent, buffers = _share_arrays(kwargs)
+            _send_shared(connection, (task, sent), buffers)
         except (RuntimeError, OSError) as exc:
             self.kill()
             return 503, (f"no compute worker available: {exc}", None)
@@ -132,9 +235,8 @@ class _Worker:
         while True:
             try:
                 if connection.poll(0.05):
-                    answer: tuple[int, Any] = connection.recv()
-                    return answer
-            except (EOFError, OSError):
+                    return _receive_answer(connection)
+            except (EOFError, OSError, RuntimeError):
                 self.kill()
                 return 503, ("the compute worker died (memory limit?); the request was not run "
                              "to its end", None)  # fmt: skip
@@ -171,6 +273,12 @@ class ComputePool:
         """The answer's bytes of ``task`` (a name in :data:`compute.TASKS`) run by a worker;
         Problem with the worker's status otherwise. The worker is killed if the client of
         ``request`` disconnects meanwhile."""
+        content, _, _ = await self.call_encoded(request, task, **kwargs)
+        return content
+
+    async def call_encoded(self, request: Request | None, task: str, **kwargs: Any) -> Encoded:
+        """As :meth:`call`: the answer's (content, media type, headers); a task that answers
+        bytes answers JSON."""
         loop = asyncio.get_running_loop()
         if self._idle is None:
             self._idle = asyncio.Queue()
@@ -196,8 +304,10 @@ class ComputePool:
             cancelled.set()
             raise
         if status == 200:
-            answer: bytes = payload
-            return answer
+            if isinstance(payload, tuple):
+                content, media, headers = payload
+                return content, media, headers
+            return payload, "application/json", {}
         detail, field = payload
         raise Problem(status, detail, field)
 

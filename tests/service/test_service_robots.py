@@ -1,5 +1,6 @@
 """The service as a user meets it (issue 34 section 6): every built-in robot through the
-kinematics endpoints, and what ``lynxplan serve`` says and where it keeps its data."""
+kinematics endpoints (5, 6 and 7 joints, arrays checked against each robot's joint count), and
+what ``lynxplan serve`` says and where it keeps its data."""
 
 from __future__ import annotations
 
@@ -15,7 +16,7 @@ from service_server import REPO, START_TIMEOUT, free_port
 
 import lynxplan
 
-ROBOTS = ("al5", "so100", "so101")
+ROBOTS = ("al5", "panda", "so100", "so101", "ur10", "ur5")
 #: Pose agreement between the service and Pinocchio's own FK, in [m] (and unitless rotation).
 FK_TOLERANCE = 1e-12
 #: IK answers: the position reached by Pinocchio's FK of the returned q, in [m].
@@ -62,6 +63,37 @@ def test_fk_and_ik_of_every_robot_agree_with_pinocchio(http: httpx.Client, name:
             pin.framesForwardKinematics(model.model, data, qb)
             reached = data.oMf[model.tool_frame_id].translation
             assert np.linalg.norm(reached - Ti[:3, 3]) < IK_TOLERANCE
+
+
+@pytest.mark.parametrize(("name", "joints"), [("ur5", 6), ("panda", 7), ("so100", 5)])
+def test_arrays_are_checked_against_the_robots_joints(
+    http: httpx.Client, name: str, joints: int
+) -> None:
+    """A 5-joint q for a 6-joint arm (and so on) is a 422 naming the field, the shape the robot
+    takes and the shape given, in JSON and in binary."""
+    wrong = joints + 1
+    fk = http.post("/fk", json={"robot": name, "q": [[0.0] * wrong]})
+    assert fk.status_code == 422 and fk.json()["field"] == "q", fk.text
+    expected = f"({joints},) or (N, {joints}) for {name} ({joints} joints). Got: (1, {wrong})"
+    assert expected in fk.json()["detail"]
+    raw = http.post(f"/fk?robot={name}", content=bytes(8 * 2 * wrong), headers={
+        "Content-Type": "application/octet-stream", "X-Shape": f"2,{wrong}"})  # fmt: skip
+    assert raw.status_code == 422 and f"Got: (2, {wrong})" in raw.json()["detail"], raw.text
+    T = np.eye(4).tolist()
+    ik = http.post("/ik", json={"robot": name, "T": T, "q_reference": [0.0] * wrong})
+    assert ik.status_code == 422 and ik.json()["field"] == "q_reference", ik.text
+    assert f"({joints},)" in ik.json()["detail"] and f"Got: ({wrong},)" in ik.json()["detail"]
+
+
+def test_motion_endpoints_name_the_robots_they_serve(http: httpx.Client) -> None:
+    """/check, /trajectory, /plan and /view serve the 5-joint robots; a 6-joint one is a 422
+    naming the robot, its joints and the robots served (never a 500 on a shape)."""
+    for path, body in (("/check", {"q": [0.0] * 6}), ("/plan", {"start": [0.0] * 6,
+                       "goal": [0.1] * 6}), ("/trajectory", {"waypoints": [[0.0] * 6] * 2}),
+                       ("/view", {"q": [0.0] * 6})):  # fmt: skip
+        answer = http.post(path, json={"robot": "ur5", **body})
+        assert answer.status_code == 422 and answer.json()["field"] == "robot", answer.text
+        assert "ur5 has 6 joints" in answer.json()["detail"] and "so101" in answer.json()["detail"]
 
 
 def test_other_endpoints_take_every_robot(http: httpx.Client) -> None:

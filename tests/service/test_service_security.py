@@ -59,20 +59,21 @@ def test_a_robot_name_is_never_a_path(http: httpx.Client, endpoint: str) -> None
     for name in ("/etc/passwd", "/etc/no-such-file-here", "../../../../etc/shadow",
                  str(REPO / "urdf" / "lynxmotion_al5.urdf")):  # fmt: skip
         details[name] = problem(http.post(endpoint, json={**body, "robot": name}), 404, "robot")
+
     # the same answer whether the path exists or not: only the caller's own value differs (the
     # server echoes at most 40 characters of it, so the comparison does too, wherever the checkout)
     def shown(name: str) -> str:
         return name if len(name) <= 40 else name[:40] + "..."
 
     assert len({detail.replace(shown(name), "X") for name, detail in details.items()}) == 1
-    assert "al5, so100, so101" in details["/etc/passwd"]
+    assert "al5, panda, so100, so101, ur10, ur5" in details["/etc/passwd"]
 
 
 @pytest.mark.parametrize("name", ["/etc/passwd", "../../../../etc/shadow", "/etc/nothing"])
 def test_a_run_cannot_name_a_server_file_as_its_robot(http: httpx.Client, name: str) -> None:
     scenario = {**trajectory_scenario(), "robot": {"name": name}}
     detail = problem(http.post("/runs", json=scenario), 422, "robot.name")
-    assert "unknown robot" in detail and "al5, so100, so101" in detail
+    assert "unknown robot" in detail and "al5, panda, so100, so101, ur10, ur5" in detail
     urdf = {**trajectory_scenario(), "robot": {"urdf": name}}
     problem(http.post("/runs", json=urdf), 422, "robot.urdf")
 
