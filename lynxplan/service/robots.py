@@ -69,17 +69,27 @@ def check_robot_name(name: object, field: str = "robot") -> str:
     return name
 
 
+#: The built-in robots loaded so far, by name (the hot routes look them up once a request).
+_LOADED: dict[str, Any] = {}
+
+
 def get_robot(name: str, field: str = "robot") -> Any:
     """The model of built-in robot ``name``: ``lynxplan.arm.Arm`` for the AL5, else a
     ``lynxplan.robots.Robot``; Problem 404 if ``name`` is not a built-in."""
+    robot = _LOADED.get(name)
+    if robot is not None:
+        return robot
     check_robot_name(name, field)
     if name == "al5":
         from lynxplan.arm.model import load_arm
 
-        return load_arm()
-    from lynxplan.robots import load_robot
+        robot = load_arm()
+    else:
+        from lynxplan.robots import load_robot
 
-    return load_robot(name)
+        robot = load_robot(name)
+    _LOADED[name] = robot
+    return robot
 
 
 def is_numerical(robot: Any) -> bool:
@@ -103,6 +113,8 @@ def ik_slots(robot: Any, approach_only: bool) -> int:
 
 def is_al5(robot: Any) -> bool:
     """Whether ``robot`` is the AL5 of ``lynxplan.arm`` (its own IK API)."""
+    if robot is _LOADED.get("al5"):
+        return True
     from lynxplan.arm.model import Arm
 
     return isinstance(robot, Arm)

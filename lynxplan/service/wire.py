@@ -102,6 +102,7 @@ def decode_binary(request: Request, body: bytes, field: str) -> np.ndarray:
             "X-Shape",
         )
     shape = tuple(int(d) for d in digits)
+    _check_dimensions(shape, "X-Shape", f"X-Shape {_shape_text(shape)}")
     elements = math.prod(shape)  # a Python int: exact for any header
     if 8 * elements != len(body):
         raise Problem(
@@ -115,6 +116,16 @@ def decode_binary(request: Request, body: bytes, field: str) -> np.ndarray:
 
 #: Most dimensions a binary array may declare (the routes take at most 3).
 MAX_DIMENSIONS = 4
+#: Largest length of one dimension of a binary array (numpy refuses some zero-size arrays
+#: with longer ones, and no batch limit comes near it).
+MAX_DIMENSION_LENGTH = 2**31 - 1
+
+
+def _check_dimensions(shape: tuple[int, ...], field: str, what: str) -> None:
+    """Problem 422 naming ``field`` when a dimension of ``shape`` is longer than
+    :data:`MAX_DIMENSION_LENGTH` (even of an empty array)."""
+    if any(length > MAX_DIMENSION_LENGTH for length in shape):
+        raise Problem(422, f"{what} has a dimension longer than {MAX_DIMENSION_LENGTH}", field)
 
 
 def _decode_npy(body: bytes, field: str) -> np.ndarray:
@@ -139,6 +150,7 @@ def _decode_npy(body: bytes, field: str) -> np.ndarray:
     if len(shape) > MAX_DIMENSIONS:
         dims = f"{len(shape)} dimensions; at most {MAX_DIMENSIONS}"
         raise Problem(422, f"the .npy array has {dims}", field)
+    _check_dimensions(shape, field, f"the .npy header's shape {_shape_text(shape)}")
     elements = math.prod(shape)
     offset = stream.tell()
     if elements * dtype.itemsize != len(body) - offset:

@@ -154,6 +154,11 @@ def _hostile() -> list[tuple[str, str, dict[str, Any], int, str, str]]:
               content=_npy_header((10**13, 4, 4)) + bytes(128), headers=npy),
         _case("xshape-not-ascii-digits", "/fk", 422, "X-Shape", "integers",
               **_raw("1,5,\u00b2".encode("latin-1"), bytes(40))),
+        # the probe after the fixes: an empty array of a dimension numpy cannot make (was 500)
+        _case("xshape-empty-2e62", "/fk", 422, "X-Shape", "dimension longer than",
+              **_raw(f"{2**62},0")),
+        _case("npy-empty-2e62", "/ik", 422, "T", "dimension longer than",
+              content=_npy_header((2**62, 0)), headers=npy),
         # section 4: hostile numbers (were 500)
         _case("toppra-acceleration-1e-300", "/trajectory", 413, "limits.acceleration",
               "samples", json={"waypoints": [START, GOAL], "method": "toppra",
