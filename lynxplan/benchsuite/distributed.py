@@ -13,7 +13,6 @@ whose search needs about 2 s there).
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from typing import Any
 
 from lynxplan.benchsuite.problem import Problem
 from lynxplan.benchsuite.runner import TIME_LIMIT, ProblemResult, run_chunk
@@ -46,42 +45,10 @@ def run_on_dask(
         InputError: neither or both of ``scheduler`` and ``local_workers``; a worker count
             below 1; a scheduler that cannot be reached.
     """
-    import distributed
+    from lynxplan.fanout.cluster import Cluster, map_chunks, open_client
 
-    client_of: Any = distributed.Client
-    local_cluster: Any = distributed.LocalCluster
-    as_completed: Any = distributed.as_completed
-
-    if (scheduler is None) == (local_workers is None):
-        raise InputError("give one of --dask-scheduler ADDRESS and --dask-local N")
-    cluster: Any = None
-    if local_workers is not None:
-        if local_workers < 1:
-            raise InputError(f"--dask-local needs at least 1 worker. Got: {local_workers}")
-        cluster = local_cluster(
-            n_workers=local_workers, threads_per_worker=1, processes=True,
-            dashboard_address=None,
-        )  # fmt: skip
-    try:
-        try:
-            client = client_of(cluster if cluster is not None else scheduler, timeout="20s")
-        except OSError as error:
-            raise InputError(f"--dask-scheduler {scheduler}: cannot connect ({error})") from error
-        with client:
-            parts = chunks(problems, chunk)
-            futures = [
-                client.submit(run_chunk, part, seed=seed, time_limit=time_limit, pure=False)
-                for part in parts
-            ]
-            order = {future.key: k for k, future in enumerate(futures)}
-            done: dict[int, list[ProblemResult]] = {}
-            count = 0
-            for future in as_completed(futures):
-                done[order[future.key]] = future.result()
-                count += len(done[order[future.key]])
-                if progress is not None:
-                    progress(count, len(problems))
-    finally:
-        if cluster is not None:
-            cluster.close()
-    return [result for k in range(len(parts)) for result in done[k]]
+    parts = chunks(problems, chunk)
+    with open_client(Cluster(scheduler, local_workers)) as client:
+        done = map_chunks(client, run_chunk, parts, sizes=[len(p) for p in parts],
+                          progress=progress, seed=seed, time_limit=time_limit)  # fmt: skip
+    return [result for part in done for result in part]

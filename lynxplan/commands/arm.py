@@ -13,6 +13,7 @@ import numpy as np
 
 from lynxplan import guards
 from lynxplan.commands import _ik_answer as _ik
+from lynxplan.commands import _ik_batch
 from lynxplan.commands import robots as robots_cmd
 from lynxplan.commands._output import (
     check_joint_limits,
@@ -69,6 +70,7 @@ def register(subparsers: Any) -> None:
     ik.add_argument("--reference", help="reference configuration, JSON list of 5 angles")
     _add_unit_options(ik)
     robots_cmd.add_robot_options(ik)
+    _ik_batch.add_batch_options(ik)
     ik.set_defaults(handler=handle_ik)
 
 
@@ -118,6 +120,10 @@ def handle_ik(args: argparse.Namespace) -> int:
     from lynxplan.arm.geometry import JOINT_NAMES
     from lynxplan.arm.ik_result import IkResult
 
+    if args.poses is not None:
+        return _ik_batch.handle(args)
+    if args.out is not None or args.dask_local is not None or args.dask_scheduler is not None:
+        raise InputError("ik: --out, --dask-local and --dask-scheduler go with --poses FILE.npy")
     if robots_cmd.wants_robot(args) or args.position is not None:
         return robots_cmd.handle_robot_ik(args)
     if args.pose is None:

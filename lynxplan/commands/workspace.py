@@ -9,6 +9,7 @@ from typing import Any
 
 from lynxplan import guards
 from lynxplan.commands import robots as robots_cmd
+from lynxplan.commands._fanout import add_dask_options, cluster_of
 from lynxplan.commands._output import parse_finite
 from lynxplan.units import LENGTH_UNITS
 
@@ -38,6 +39,7 @@ def register(subparsers: Any) -> None:
     parser.add_argument("--seed", default="0", help="random seed, 0 <= seed < 2**63 (default 0)")
     parser.add_argument("--json", action="store_true", help="print workspace.json to stdout")
     robots_cmd.add_robot_options(parser)
+    add_dask_options(parser)
     parser.set_defaults(handler=handle)
 
 
@@ -50,6 +52,7 @@ def handle(args: argparse.Namespace) -> int:
 
     if args.quick and args.samples is not None:
         raise InputError("workspace: --quick and --samples contradict each other; give one")
+    cluster = cluster_of(args)
     samples = QUICK_SAMPLES if args.quick else DEFAULT_SAMPLES
     if args.samples is not None:
         samples = guards.count("workspace --samples", _integer(args.samples, "--samples"))
@@ -75,7 +78,7 @@ def handle(args: argparse.Namespace) -> int:
     )
     out = Path(args.out)
     with staged_outputs(out, force=getattr(args, "force", False)) as staging:
-        outcome = workspace_scenario.run(scenario)
+        outcome = workspace_scenario.run(scenario, cluster=cluster)
         workspace_scenario.write_outputs(scenario, outcome, staging, quick=args.quick)
         summary = (staging / "workspace.json").read_text(encoding="utf-8")
     if args.json:

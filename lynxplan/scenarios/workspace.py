@@ -20,6 +20,7 @@ Artifacts: ``workspace.json`` and, unless quick, ``workspace_*.png`` and ``works
 
 from __future__ import annotations
 
+from functools import partial
 from pathlib import Path
 from typing import Any, ClassVar, Literal
 
@@ -64,9 +65,10 @@ class Input(ScenarioModel):
         return data
 
 
-def run(scenario: Input, *, quick: bool = False) -> KindOutput:
+def run(scenario: Input, *, quick: bool = False, cluster: Any = None) -> KindOutput:
     """Sample the workspace and measure it (no files): the AL5's planar envelope, or the
-    sampled points of any other robot."""
+    sampled points of any other robot. ``cluster`` (a :class:`lynxplan.fanout.Cluster`): the
+    sweep in chunks on Dask, the same estimate."""
     from lynxplan.arm.model import Arm
     from lynxplan.arm.workspace import estimate_workspace, report_grid, tool_positions
     from lynxplan.progress import progress_bar
@@ -74,7 +76,11 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
 
     arm = load_robot_entry(scenario.robot)
     if not isinstance(arm, Arm):
-        return _run_sampled(scenario, arm)
+        return _run_sampled(scenario, arm, cluster)
+    if cluster is not None:
+        from lynxplan.fanout.workspace import estimate_workspace_on_dask
+
+        estimate_workspace = partial(estimate_workspace_on_dask, cluster=cluster)
     unit = scenario.units.length
     scale = length_factor(unit)
     with progress_bar("sampling workspace") as progress:
@@ -115,10 +121,15 @@ def _sampled_metrics(estimate: Any) -> dict[str, Any]:
     }
 
 
-def _run_sampled(scenario: Input, robot: Any) -> KindOutput:
+def _run_sampled(scenario: Input, robot: Any, cluster: Any) -> KindOutput:
     """Any robot of ``lynxplan.load_robot``: voxel volume, reach and height of sampled points."""
     from lynxplan.progress import progress_bar
     from lynxplan.robots.workspace import sample_workspace
+
+    if cluster is not None:
+        from lynxplan.fanout.workspace import sample_workspace_on_dask
+
+        sample_workspace = partial(sample_workspace_on_dask, cluster=cluster)
 
     unit = scenario.units.length
     scale = length_factor(unit)
