@@ -169,3 +169,54 @@ BLOCK_OTHER_MARGIN = 1e-9
 #: Both flips are computed where the approach's component along the yaw axis [1] or the
 #: target's distance from it [m] is within this of 0 (the pitch sum or yaw may be degenerate).
 BLOCK_OTHER_DEGENERATE = 1e-9
+
+# -- the IK solvers' tolerances and thresholds (moved from their modules, same values) --
+
+#: Where the ideal branch misses the target by more than this [m] the exact one (~1e-7 m away)
+#: cannot reach it either: undefined without a polish.
+REACH_MARGIN = 1e-6
+#: The chord method keeps its Jacobian while each step divides the conditions by 1 / CHORD_RATE.
+CHORD_RATE = 1e-3
+#: Finite-difference step of the Jacobian of the conditions [rad].
+POLISH_FD_STEP = 1e-7
+#: The yaw one side of the lateral offset gives must match the orientation's within this [rad],
+#: plus YAW_MATCH_LENGTH / (distance from the yaw axis) (the ideal model's tool point differs
+#: from the exact chain's by ~1e-6 m for the SO-101, which turns the yaw more near the axis),
+#: and within YAW_MATCH_DEVIATIONS times what the model's deviation from the ideal family can
+#: move it (``yaw_match``): the yaw of the other flip misses by twice the lateral offset over
+#: the distance (~4e-4 m / rho for the SO-101), the exact branches' by < 8 deviations (1e6 poses).
+YAW_MATCH, YAW_MATCH_LENGTH = 1e-3, 1e-4
+YAW_MATCH_DEVIATIONS = 30.0
+#: The deviation the yaw match assumes at least [rad] (an exact model's rounding).
+MIN_DEVIATION = 1e-9
+#: The approach this close to the yaw axis leaves the yaw to the position: root search.
+AXIAL_APPROACH = 1e-6
+#: A closed-form branch that misses the reach by more than this [m] is not polished.
+REACH_MISS = 1e-5
+#: An iteration must divide the error by at least this much, or the polish stops: from a
+#: closed-form start it falls quadratically (1e-6, 1e-12, ...), next to a fold of the elbow
+#: (a double root: the error ~ the square of the joint gap, which Newton halves) by ~4 per
+#: step; a start that is not near an exact branch falls slower and stops early.
+MIN_FALL = 2.0
+#: Below this the target is on the yaw axis, or the approach along the pitch axis [m], [1]:
+#: there the angle form (with its reference angles) is used.
+ROLL_DEGENERATE = 1e-12
+#: Near-roots of the ideal model (|f| below this at a local extremum) are tried on the exact one.
+NEAR_ROOT = 5e-3
+#: A model only close to the family: where the ideal equation is below this many times the
+#: model's deviation (times 1 + d / rho, d the target's distance from the shoulder, rho the
+#: wrist circle's radius), the roots are searched on the exact chain (``exact_roll_equation.py``).
+EXACT_BAND = 16.0
+#: Roots of the two elbows' exact equations closer than this are one root [rad] (each elbow's
+#: branch is then polished from it).
+ROOT_MERGE = 1e-6
+#: Brent's minimisation: relative and absolute tolerance on the minimiser [rad].
+BRENT_RELATIVE, BRENT_ABSOLUTE = 1.5e-8, 1e-11
+#: Targets this much closer to the yaw axis than the wrist's lateral offset plus the tool's
+#: off-axis distance are "near the axis" [m]: there the yaw is so sensitive that a model only
+#: close to the family (SO-101) can hide a root of the exact model from the ideal one.
+NEAR_AXIS_MARGIN = 0.01
+#: Elbow cosines this close to +-1 are +-1 (a straight or folded elbow).
+FOLD_SNAP_TOLERANCE = 1e-14
+#: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
+FAR_AWAY = 1e9

@@ -14,7 +14,13 @@ import numba
 import numpy as np
 
 from lynxplan._fastmath import atan2, sincos
-from lynxplan.constants import BASE_AXIS_TOLERANCE, RIGIDITY_REPAIR_TOLERANCE, WRIST_SNAP_TOLERANCE
+from lynxplan.constants import (
+    BASE_AXIS_TOLERANCE,
+    FAR_AWAY,
+    FOLD_SNAP_TOLERANCE,
+    RIGIDITY_REPAIR_TOLERANCE,
+    WRIST_SNAP_TOLERANCE,
+)
 
 TWO_PI = 2.0 * math.pi
 #: IEEE-safe fast-math flags: fused multiply-add and division by reciprocal (rounding differs
@@ -81,10 +87,8 @@ class IkOutputs(NamedTuple):
 RIGIDITY_REPAIR_TOLERANCE_K = RIGIDITY_REPAIR_TOLERANCE
 BASE_AXIS_TOLERANCE_K = BASE_AXIS_TOLERANCE
 WRIST_SNAP_TOLERANCE_K = WRIST_SNAP_TOLERANCE
-#: Elbow cosines this close to +-1 are +-1 (a straight or folded elbow).
-FOLD_SNAP_K = 1e-14
-#: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
-FAR_AWAY_K = 1e9
+FOLD_SNAP_K = FOLD_SNAP_TOLERANCE  # elbow cosines this close to +-1 are +-1
+FAR_AWAY_K = FAR_AWAY  # [m]: out of reach before any arithmetic can overflow
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)

@@ -14,12 +14,12 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from lynxplan.constants import EXACT_BAND
 from lynxplan.robots import Robot, load_robot
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.exact_roll_equation import exact_roll_equation
 from lynxplan.robots.ik.family_geometry import MODE_APPROACH
 from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms, roll_equation
-from lynxplan.robots.ik.roll_search import EXACT_BAND
 from tests.robots.urdf_factory import tilted_urdf, write_random_family_urdfs
 
 #: The start configuration is a branch when every joint agrees to this [rad], or to

@@ -13,9 +13,11 @@ import numpy as np
 
 from lynxplan._fastmath import wide_vectors
 from lynxplan.constants import (
+    AXIAL_APPROACH,
     BLOCK_FOLD_BAND,
     BLOCK_OTHER_DEGENERATE,
     BLOCK_OTHER_MARGIN,
+    REACH_MISS,
 )
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.block_layout import (
@@ -33,7 +35,7 @@ from lynxplan.robots.ik.block_layout import (
     put_flip,
 )
 from lynxplan.robots.ik.family_geometry import best_roll_terms, wrap
-from lynxplan.robots.ik.pose_kernel import AXIAL_APPROACH, REACH_MISS, yaw_match
+from lynxplan.robots.ik.pose_kernel import yaw_match
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)

@@ -16,7 +16,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
-from lynxplan.constants import HELD_TOLERANCE
+from lynxplan.constants import HELD_TOLERANCE, REACH_MARGIN
 from lynxplan.robots.ik.family_geometry import ChainProblem, RollProblem, branch
 from lynxplan.robots.ik.family_polish import conditions, polish
 
@@ -25,10 +25,6 @@ from lynxplan.robots.ik.family_polish import conditions, polish
 ExactProblem = tuple[
     RollProblem, ChainProblem, int, np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray
 ]
-
-#: Where the ideal branch misses the target by more than this [m] the exact one (~1e-7 m away)
-#: cannot reach it either: undefined without a polish.
-REACH_MARGIN = 1e-6
 
 
 @numba.njit(cache=True, nogil=True)

@@ -13,7 +13,7 @@ import numba
 import numpy as np
 
 from lynxplan.arm.ik_kernel import wrap_into_limits
-from lynxplan.constants import POLISH_CONDITION_TOLERANCE
+from lynxplan.constants import CHORD_RATE, POLISH_CONDITION_TOLERANCE, POLISH_FD_STEP
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
 from lynxplan.robots.ik.family_geometry import (
@@ -26,10 +26,6 @@ from lynxplan.robots.ik.family_geometry import (
 
 #: Newton iterations at most (it stops below ``constants.POLISH_CONDITION_TOLERANCE``).
 NEWTON_STEPS = 40
-#: The chord method keeps its Jacobian while each step divides the conditions by 1 / CHORD_RATE.
-CHORD_RATE = 1e-3
-#: Finite-difference step of the Jacobian of the conditions [rad].
-_FD_STEP = 1e-7
 
 
 @numba.njit(cache=True, nogil=True)
@@ -177,10 +173,10 @@ def polish(
         if not factored:
             for j in range(5):
                 qh[:] = q
-                qh[j] += _FD_STEP
+                qh[j] += POLISH_FD_STEP
                 conditions(problem, roll_given, qh, pose, work, e2)
                 for i in range(5):
-                    jac[i, j] = (e2[i] - e[i]) / _FD_STEP
+                    jac[i, j] = (e2[i] - e[i]) / POLISH_FD_STEP
             if not lu_factor(jac):
                 break
             factored = fresh = True

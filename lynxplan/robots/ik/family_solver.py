@@ -11,7 +11,7 @@ import numpy as np
 
 from lynxplan import _jit
 from lynxplan._arrays import kernel_input
-from lynxplan.constants import REACH_TOLERANCE
+from lynxplan.constants import NEAR_AXIS_MARGIN, REACH_TOLERANCE
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
@@ -167,10 +167,6 @@ def _general(
     return reachable, distance
 
 
-#: Targets this much closer to the yaw axis than the wrist's lateral offset plus the tool's
-#: off-axis distance are "near the axis" [m]: there the yaw is so sensitive that a model only
-#: close to the family (SO-101) can hide a root of the exact model from the ideal one.
-NEAR_AXIS_MARGIN = 0.01
 #: Besides the closed-form branches, the rescue starts from this many fixed random configurations.
 RESCUE_STARTS = 16
 RESCUE_SEED = 5

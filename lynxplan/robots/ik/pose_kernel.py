@@ -26,10 +26,17 @@ import numba
 import numpy as np
 
 from lynxplan.constants import (
+    AXIAL_APPROACH,
     BRANCH_DUPLICATE_TOLERANCE,
+    MIN_DEVIATION,
+    MIN_FALL,
     POSE_EXACT,
     POSE_POLISH_TOLERANCE,
+    REACH_MISS,
     RIGID_TOLERANCE,
+    YAW_MATCH,
+    YAW_MATCH_DEVIATIONS,
+    YAW_MATCH_LENGTH,
 )
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
@@ -42,21 +49,6 @@ from lynxplan.robots.ik.family_polish import (
     settle,
 )
 from lynxplan.robots.results import BranchSlots
-
-#: The yaw one side of the lateral offset gives must match the orientation's within this [rad],
-#: plus YAW_MATCH_LENGTH / (distance from the yaw axis) (the ideal model's tool point differs
-#: from the exact chain's by ~1e-6 m for the SO-101, which turns the yaw more near the axis),
-#: and within YAW_MATCH_DEVIATIONS times what the model's deviation from the ideal family can
-#: move it (``yaw_match``): the yaw of the other flip misses by twice the lateral offset over
-#: the distance (~4e-4 m / rho for the SO-101), the exact branches' by < 8 deviations (1e6 poses).
-YAW_MATCH, YAW_MATCH_LENGTH = 1e-3, 1e-4
-YAW_MATCH_DEVIATIONS = 30.0
-#: The deviation the yaw match assumes at least [rad] (an exact model's rounding).
-MIN_DEVIATION = 1e-9
-#: The approach this close to the yaw axis leaves the yaw to the position: root search.
-AXIAL_APPROACH = 1e-6
-#: A closed-form branch that misses the reach by more than this [m] is not polished.
-REACH_MISS = 1e-5
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -80,11 +72,6 @@ def yaw_match(deviation: float, reach: float, axial: float, rho: float, lateral:
 #: Gauss-Newton iterations of the polish at most (it stops below
 #: ``constants.POSE_POLISH_TOLERANCE``).
 NEWTON_STEPS = 60
-#: An iteration must divide the error by at least this much, or the polish stops: from a
-#: closed-form start it falls quadratically (1e-6, 1e-12, ...), next to a fold of the elbow
-#: (a double root: the error ~ the square of the joint gap, which Newton halves) by ~4 per
-#: step; a start that is not near an exact branch falls slower and stops early.
-MIN_FALL = 2.0
 
 
 class PoseScratch(NamedTuple):

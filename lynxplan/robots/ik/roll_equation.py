@@ -16,6 +16,7 @@ import math
 import numba
 import numpy as np
 
+from lynxplan.constants import ROLL_DEGENERATE
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
@@ -24,10 +25,6 @@ from lynxplan.robots.ik.family_geometry import (
     pitch_sum,
     yaw,
 )
-
-#: Below this the target is on the yaw axis, or the approach along the pitch axis [m], [1]:
-#: there the angle form (with its reference angles) is used.
-_DEGENERATE = 1e-12
 
 
 @numba.njit(cache=True, nogil=True)
@@ -106,7 +103,7 @@ def roll_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]
     """
     prm, _, g, mode, side, _, _ = problem
     rho = g[3, 0]
-    if rho <= _DEGENERATE:
+    if rho <= ROLL_DEGENERATE:
         return reference_terms(problem, theta)
     ct, st = math.cos(theta), math.sin(theta)
     lat = prm[F.LAM4] + prm[F.W0 + 2] + ct * prm[F.E1 + 2] + st * prm[F.E2 + 2]
@@ -127,7 +124,7 @@ def roll_terms(problem: RollProblem, theta: float) -> tuple[float, float, float]
         return cphi * ap + sphi * ah, 1.0, miss
     in_h = cphi * ah - sphi * ap
     norm = math.sqrt(in_h * in_h + ak * ak)
-    if norm <= _DEGENERATE:  # approach along the pitch axis: the reference pitch sum
+    if norm <= ROLL_DEGENERATE:  # approach along the pitch axis: the reference pitch sum
         return reference_terms(problem, theta)
     # pitch sum Phi = atan2(ak, in_h) - gamma0
     cg, sg = g[4, 2], g[4, 3]
@@ -177,7 +174,7 @@ def lateral_miss(problem: RollProblem, theta: float) -> float:
     dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
     dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
     rho = math.hypot(dp, dh)
-    if rho <= _DEGENERATE:
+    if rho <= ROLL_DEGENERATE:
         return yaw(prm, d0, d1, d2, theta, side, phi_ref)[1]
     lat: float = (
         prm[F.LAM4]

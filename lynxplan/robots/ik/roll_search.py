@@ -18,6 +18,9 @@ import numpy as np
 from lynxplan.constants import (
     BOUNDARY_TOLERANCE,
     CLAMPED_ROOT_TOLERANCE,
+    EXACT_BAND,
+    NEAR_ROOT,
+    ROOT_MERGE,
     TANGENT_TOLERANCE,
 )
 from lynxplan.robots import family as F  # noqa: N812
@@ -42,19 +45,10 @@ SUBDIVISION = 16
 FAST_CHANGE = 0.25
 #: Samples between a grid point and a reach boundary of the yaw (quadratically spaced).
 BOUNDARY_SAMPLES = 32
-#: Near-roots of the ideal model (|f| below this at a local extremum) are tried on the exact one.
-NEAR_ROOT = 5e-3
 #: At most this many roll roots per side are kept (each gives two elbow branches).
 MAX_ROOTS = 6
 #: Grid samples of one side at most (uniform points, subdivisions, boundary samples).
 GRID_SIZE = ROOT_GRID * (BOUNDARY_SAMPLES + SUBDIVISION) + 2
-#: A model only close to the family: where the ideal equation is below this many times the
-#: model's deviation (times 1 + d / rho, d the target's distance from the shoulder, rho the
-#: wrist circle's radius), the roots are searched on the exact chain (``exact_roll_equation.py``).
-EXACT_BAND = 16.0
-#: Roots of the two elbows' exact equations closer than this are one root [rad] (each elbow's
-#: branch is then polished from it).
-ROOT_MERGE = 1e-6
 
 
 @numba.njit(cache=True, nogil=True)

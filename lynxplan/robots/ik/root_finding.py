@@ -12,13 +12,10 @@ import numba
 import numpy as np
 from numba.extending import overload
 
-from lynxplan.constants import EXACT_ROOT_STEP
+from lynxplan.constants import BRENT_ABSOLUTE, BRENT_RELATIVE, EXACT_ROOT_STEP
 from lynxplan.robots.ik.exact_roll_equation import ExactProblem, exact_roll_equation
 from lynxplan.robots.ik.family_geometry import RollProblem
 from lynxplan.robots.ik.roll_equation import roll_equation
-
-#: Brent's minimisation: relative and absolute tolerance on the minimiser [rad].
-_BRENT_RELATIVE, _BRENT_ABSOLUTE = 1.5e-8, 1e-11
 
 
 def equation(problem: RollProblem | ExactProblem, theta: float) -> float:
@@ -100,7 +97,7 @@ def minimise(  # noqa: PLR0912 (Brent's method as published, one compiled loop)
     d = e = 0.0
     for _ in range(100):
         xm = 0.5 * (a + b)
-        tol1 = _BRENT_RELATIVE * abs(x) + _BRENT_ABSOLUTE
+        tol1 = BRENT_RELATIVE * abs(x) + BRENT_ABSOLUTE
         tol2 = 2.0 * tol1
         if abs(x - xm) <= tol2 - 0.5 * (b - a):
             break
