@@ -34,7 +34,7 @@ from lynxplan.planning.kernel_model import (
     njit_no_refcount,
     stack_array,
 )
-from lynxplan.planning.pair_bound import obb_gap, point_box_gap
+from lynxplan.planning.pair_bound import ALL_AXES, obb_gap, point_box_gap
 
 #: Joints (frames) a kernel model may have for the lanes (the scalar walk serves larger ones).
 MAX_JOINTS = 12
@@ -164,6 +164,7 @@ def _box_bounds(
             (ha0, ha1, ha2),
             (hb0, hb1, hb2),
             rab,
+            ALL_AXES,
         )
 
 

@@ -34,6 +34,10 @@ from lynxplan.planning.kernel_model import OBSTACLE_SPHERE, njit_refcounted
 #: Pairs whose bounding-sphere gap exceeds the clearance by more than this skip the separating
 #: axis test in :func:`pair_bound_below` (its bound cannot limit a step much), in [m].
 SAT_SKIP_DISTANCE = 0.15
+#: The scalar :func:`pair_bound` tries the 9 edge axes only below this face-axis gap, in [m].
+EDGE_AXES_BELOW = 0.02
+#: :func:`obb_gap`'s ``edges_below`` for every axis.
+ALL_AXES = np.inf
 #: Edge axes with squared norm below this are left out (near-parallel edges).
 _PARALLEL = 1e-6
 #: IEEE-safe fast-math flags (fused multiply-add, reciprocal division; see ik_kernel).
@@ -48,9 +52,12 @@ def obb_gap(
     ha: tuple[float, float, float],
     hb: tuple[float, float, float],
     rab: float,
+    edges_below: float,
 ) -> float:
     """Lower bound of the distance of two oriented boxes, in [m]: the larger of the sphere gap
-    ``|t| - rab`` and the separating-axis gap over the 15 axes.
+    ``|t| - rab`` and the separating-axis gap over the 15 axes (the 9 edge axes only when the
+    face axes leave a gap below ``edges_below`` [m]: any subset of the axes gives a valid bound;
+    the vectorised loops pass :data:`ALL_AXES`, a compile-time constant, and have no branch).
 
     t: centre of B minus centre of A (world); ra, rb: the three rows of the boxes' rotations
     (columns: the box axes); ha, hb: half sizes; rab: the sum of their bounding radii. No
@@ -94,6 +101,8 @@ def obb_gap(
     best = max(best, abs(v0) - hb0 - ha0 * r00 - ha1 * r10 - ha2 * r20)
     best = max(best, abs(v1) - hb1 - ha0 * r01 - ha1 * r11 - ha2 * r21)
     best = max(best, abs(v2) - hb2 - ha0 * r02 - ha1 * r12 - ha2 * r22)
+    if edges_below < ALL_AXES and best >= edges_below:
+        return best
     # edge axes a_k x b_l, in A's frame e_k x (m_0l, m_1l, m_2l); squared norm 1 - m_kl^2
     best = _edge(best, u2 * m10 - u1 * m20, ha1 * r20 + ha2 * r10, hb1 * r02 + hb2 * r01, m00)
     best = _edge(best, u2 * m11 - u1 * m21, ha1 * r21 + ha2 * r11, hb0 * r02 + hb2 * r00, m01)
@@ -176,7 +185,7 @@ def pair_bound_below(p: int, model: Any, scratch: Any, enough: float) -> float:
     if gap >= min(enough, SAT_SKIP_DISTANCE):
         return gap
     hb = (half_b[b, 0], half_b[b, 1], half_b[b, 2])
-    return obb_gap(t, ra, rotation_rows(other, b), ha, hb, rab)
+    return obb_gap(t, ra, rotation_rows(other, b), ha, hb, rab, EDGE_AXES_BELOW)
 
 
 #: Pairs per block of :func:`all_pair_bounds` (a constant width: no run-time aliasing checks).
@@ -251,6 +260,7 @@ def all_pair_bounds(model: Any, poses: np.ndarray, out: np.ndarray) -> None:
                 half_a,
                 (w[_HB, i], w[_HB + 1, i], w[_HB + 2, i]),
                 w[_RAB, i],
+                ALL_AXES,
             )
             # sphere obstacle: the point-box distance of its centre minus its radius (exact)
             sphere = point_box_gap(t, rows_a, half_a) - w[_SR, i]

@@ -17,7 +17,7 @@ from lynxplan.planning.lanes import (
     pair_along,
     spheres_along,
 )
-from lynxplan.planning.pair_bound import SAT_SKIP_DISTANCE, all_pair_bounds, pair_bound
+from lynxplan.planning.pair_bound import EDGE_AXES_BELOW, all_pair_bounds, pair_bound
 from lynxplan.planning.sphere_gaps import sphere_gap
 from lynxplan.planning.validity import ValidityChecker, primitive_poses
 from lynxplan.planning.verify import ExactVerifier
@@ -53,8 +53,9 @@ def test_all_pair_bounds_equal_the_scalar_bounds_and_stay_below_coal(
         primitive_poses(q, model, scratch)
         all_pair_bounds(model, scratch.prim_poses, out)
         scalar = np.array([pair_bound(p, model, scratch) for p in range(len(out))])
-        # one definition: the same bound, but where the scalar one stops at the sphere gap
-        tight = scalar < SAT_SKIP_DISTANCE
+        # one definition: the same bound, where the scalar one tries every axis (it stops at
+        # the sphere gap or the face axes when they are far enough)
+        tight = scalar < EDGE_AXES_BELOW
         np.testing.assert_allclose(out[tight], scalar[tight], atol=ROUNDING)
         assert (out >= scalar - ROUNDING).all()
         exact = _exact(verifier, checker, scratch.prim_poses)
