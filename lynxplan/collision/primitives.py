@@ -68,9 +68,19 @@ def joint_structure(model: Any) -> tuple[list[tuple[int, int]], list[np.ndarray]
     return axes, placements
 
 
+#: Centred hulls already built in this process, by the hash of their mesh's hull vertices: a
+#: robot's worlds (one per scene, e.g. each problem of a benchmark) share them instead of
+#: rebuilding each mesh's hull (the SO-101's 17 meshes: ~0.2 s a world).
+_HULLS: dict[bytes, tuple[Any, np.ndarray, np.ndarray]] = {}
+#: At most this many hulls are kept (a robot has tens of meshes).
+_HULLS_KEPT = 512
+
+
 def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray, np.ndarray]:
     """Convex hull of a mesh (coal BVH or Convex) centred on its bounding box, the offset (4, 4)
     of that frame in the geometry frame, and the hull's vertices (K, 3) in it [m]."""
+    import hashlib
+
     import coal
 
     if not type(shape).__name__.startswith("Convex"):
@@ -80,13 +90,23 @@ def _mesh_hull(shape: Any, name: str) -> tuple[Any, np.ndarray, np.ndarray]:
     points = np.array(shape.points(), dtype=float).reshape(-1, 3)
     if points.shape[0] < 4 or not np.isfinite(points).all():
         raise CollisionModelError(name, "mesh has no usable vertices for a convex hull")
+    key = hashlib.blake2b(points.tobytes(), digest_size=16).digest()
+    known = _HULLS.get(key)
+    if known is not None:
+        return known
     centre = (points.min(axis=0) + points.max(axis=0)) / 2.0
     shifted = coal.StdVec_Vec3s()
     shifted.extend(list(points - centre))
     hull = coal.Convex.convexHull(shifted, False, "Qt")
     offset = np.eye(4)
     offset[:3, 3] = centre
-    return hull, offset, points - centre
+    centred = points - centre
+    for array in (offset, centred):
+        array.setflags(write=False)
+    if len(_HULLS) >= _HULLS_KEPT:
+        _HULLS.clear()
+    _HULLS[key] = (hull, offset, centred)
+    return hull, offset, centred
 
 
 def _cover(kind: str, half: np.ndarray) -> tuple[np.ndarray, float]:

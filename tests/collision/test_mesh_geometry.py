@@ -82,3 +82,19 @@ def test_sphere_bound_is_below_the_exact_distance(world) -> None:
     apart = (exact > 0) | (bound > 0)  # in contact, a bound <= 0 proves nothing (see world.py)
     assert (bound[apart] <= exact[apart] + 1e-12).all()
     assert (bound > 0).any()  # the bound proves something, not only <= 0
+
+
+def test_a_second_world_reuses_the_hulls_and_answers_the_same(world):
+    """Worlds of the same robot share each mesh's centred hull (built once per process), and a
+    second world's distances equal the first's (up to GJK's warm-start rounding, 1e-12 m)."""
+    robot, first = world
+    second = CollisionWorld(robot, first.obstacles, self_collision=True)
+    meshes = [k for k, link in enumerate(first.links) if link.kind == "mesh"]
+    assert meshes
+    for k in meshes:
+        assert second.links[k].shape is first.links[k].shape
+        np.testing.assert_array_equal(second.links[k].placement, first.links[k].placement)
+    rng = np.random.default_rng(7)
+    bounds = np.asarray(robot.limits.position)  # (n, 2) [rad]
+    for q in rng.uniform(bounds[:, 0], bounds[:, 1], size=(5, len(bounds))):
+        np.testing.assert_allclose(second.distances(q), first.distances(q), rtol=0, atol=1e-12)
