@@ -114,7 +114,7 @@ def _chain(
     for j in range(q_a.shape[0]):
         static += model.rates[p, j] * scratch.dq[j]
     s, b, trend = 0.0, ends[0], 0.0  # trend: the bound's change per unit s at the last step
-    pose_pair_at(q_a, q_b, 0.0, p, model, scratch, 0)  # its lever arms (b: the caller's)
+    pose_pair_at(q_a, q_b, 0.0, p, model, scratch, np.int64(0))  # lever arms (not a literal)
     while True:
         if count >= pair.shape[0]:
             return -1
@@ -130,7 +130,7 @@ def _chain(
         one = reach_step(b, p, arms, 0, model, scratch)
         t = min(1.0, s + two_sided_step(b, one, trend))
         while True:  # halve the step until the two-sided test passes (one inlined bound)
-            bt = pair_bound_at(q_a, q_b, t, p, model, scratch, 1)
+            bt = pair_bound_at(q_a, q_b, t, p, model, scratch, np.int64(1))
             span = span_motion(p, t - s, model, scratch)
             if b + bt > span or t - s < MIN_STEP:
                 break

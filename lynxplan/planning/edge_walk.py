@@ -391,7 +391,7 @@ def edge_walk(
             if run < 0.0:  # blocked within the one-sided reach: the edge is certified to -run
                 counters[3] = p
                 return -run
-        slack_t = pair_bound_at(q_a, q_b, nearest, p, model, scratch, 1) - clearance
+        slack_t = pair_bound_at(q_a, q_b, nearest, p, model, scratch, np.int64(1)) - clearance
         counters[1] += 1
         counters[2] += 1
         if slack_t <= STALL_DISTANCE:
