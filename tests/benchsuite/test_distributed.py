@@ -13,10 +13,12 @@ from lynxplan.exceptions import InputError
 def test_local_cluster_results_equal_serial() -> None:
     problems = [p for p in load_shipped("al5") if p.index == 0][:4]
     seen: list[tuple[int, int]] = []
+    # serial first: its process compiles the kernels into numba's cache, and the workers load
+    # them from there (three processes compiling the planner at once doubled the test's time)
+    serial = run_serial(problems)
     distributed = run_on_dask(
         problems, local_workers=2, chunk=1, progress=lambda d, n: seen.append((d, n))
     )
-    serial = run_serial(problems)
     assert [r.outcome() for r in distributed] == [r.outcome() for r in serial]
     assert seen[-1] == (4, 4) and len(seen) == 4
 
