@@ -111,7 +111,7 @@ def geometry_model(robot: Any, kind: str, *, hulls: bool) -> Any:
         MeshNotFoundError: a mesh of that kind found nowhere, naming it.
         ModelError: a mesh file that cannot be read.
     """
-    xml = resolve_urdf_meshes(robot._urdf_xml, robot.urdf_path, robot.package_dirs, (kind,))
+    xml = resolve_urdf_meshes(robot.urdf_xml, robot.urdf_path, robot.package_dirs, (kind,))
     if hulls:
         xml = hull_urdf(xml, robot.urdf_path.parent, robot.package_dirs)
     return build_geometry_model(robot.model, xml, robot.urdf_path.name, kind)

@@ -125,6 +125,12 @@ class Robot:
 
     # -- description ------------------------------------------------------------------------
     @property
+    def urdf_xml(self) -> str:
+        """The URDF text as loaded, its locked joints made fixed (what the geometry models and
+        peers built from this robot read)."""
+        return str(self._urdf_xml)
+
+    @property
     def ik_solver(self) -> str:
         """Name of the IK solver this robot uses."""
         return self.kinematics.solver_name

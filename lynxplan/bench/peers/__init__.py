@@ -45,7 +45,7 @@ def peer_urdf(robot: Any, folder: Path) -> Path:
     from lynxplan.mesh_paths import resolve_urdf_meshes
     from lynxplan.robots.hull_cache import hull_urdf
 
-    xml = robot._urdf_xml  # the robot's URDF as loaded (a built-in may differ from its file)
+    xml = robot.urdf_xml  # the robot's URDF as loaded (a built-in may differ from its file)
     xml = resolve_urdf_meshes(xml, robot.urdf_path, robot.package_dirs, ("collision",))
     xml = hull_urdf(xml, robot.urdf_path.parent, tuple(robot.package_dirs))
     path = Path(folder) / f"{robot.urdf_path.stem}.peer.urdf"
