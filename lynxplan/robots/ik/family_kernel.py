@@ -31,6 +31,7 @@ from lynxplan.robots.ik.family_geometry import (
 )
 from lynxplan.robots.ik.family_polish import (
     branch_orientation_error,
+    copy5,
     is_duplicate,
     polish,
     settle,
@@ -219,12 +220,12 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                         else:
                             polished = True
                     elif not exact and not rooted:
-                        trial[:] = q
+                        copy5(q, trial)
                         if (
                             polish(chain_problem, np.nan, trial, scratch, scratch4, scratch5)
                             < POLISH_CONDITION_TOLERANCE
                         ):
-                            q[:] = trial
+                            copy5(trial, q)
                             polished = True
                         else:
                             miss = branch(problem, pitch[n], nearest, elbow, q)

@@ -76,6 +76,15 @@ def lu_solve(lu: np.ndarray, b: np.ndarray, x: np.ndarray) -> None:
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
+def copy5(src: np.ndarray, dst: np.ndarray) -> None:
+    """dst[:5] = src[:5], element by element. A slice assignment (``dst[:] = src``) checks the
+    shapes and compiles numba's error message for a mismatch (string formatting, ~2 s of the
+    IK kernel's first compile); a plain copy is the same bits."""
+    for j in range(5):
+        dst[j] = src[j]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
 def reached_approach(prm: np.ndarray, pose: np.ndarray) -> tuple[float, float, float]:
     """The approach axis of a reached pose (4, 4), in the base frame: R (Rt0^T r)."""
     rt = prm[F.RT0 : F.RT0 + 9]
@@ -162,7 +171,7 @@ def polish(
     e, e2, qh, start, qt = scratch[0], scratch[1], scratch[2], scratch[3], scratch[4]
     step = scratch[5]
     jac = scratch5
-    start[:] = q
+    copy5(q, start)
     conditions(problem, roll_given, q, pose, work, e)
     first = max(abs(e[0]), abs(e[1]), abs(e[2]), abs(e[3]), abs(e[4]))
     norm = first
@@ -172,7 +181,7 @@ def polish(
             break
         if not factored:
             for j in range(5):
-                qh[:] = q
+                copy5(q, qh)
                 qh[j] += POLISH_FD_STEP
                 conditions(problem, roll_given, qh, pose, work, e2)
                 for i in range(5):
@@ -191,8 +200,8 @@ def polish(
             conditions(problem, roll_given, qt, pose, work, e2)
             trial = max(abs(e2[0]), abs(e2[1]), abs(e2[2]), abs(e2[3]), abs(e2[4]))
             if trial < norm:
-                q[:] = qt
-                e[:] = e2
+                copy5(qt, q)
+                copy5(e2, e)
                 norm = trial
                 accepted = True
                 break
@@ -203,7 +212,7 @@ def polish(
         factored = accepted and norm <= CHORD_RATE * before
         fresh = False
     if not (norm <= first):
-        q[:] = start
+        copy5(start, q)
         return float(first)
     return float(norm)
 
