@@ -143,6 +143,35 @@ def tool_positions(q: np.ndarray, geometry: ArmGeometry) -> np.ndarray:
     )
 
 
+def checked_inputs(
+    geometry: ArmGeometry, samples: int, voxel_size: float, cell: float, seed: int
+) -> tuple[int, int]:
+    """The sample count and seed of :func:`estimate_workspace` checked (and the sizes they imply:
+    the planar grid, the voxel indices), for the serial sweep and the Dask one alike.
+
+    Raises:
+        InputError: for a non-positive sample count, voxel or cell size, a grid too large.
+    """
+    if samples < 1:
+        raise InputError(f"workspace: samples must be >= 1. Got: {samples}")
+    for name, value in (("voxel_size", voxel_size), ("cell", cell)):
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(f"workspace: {name} must be a positive length in m. Got: {value}")
+    from lynxplan import guards
+
+    samples = guards.count("workspace samples", samples)
+    guards.positive_length("workspace voxel_size", voxel_size)
+    guards.positive_length("workspace cell", cell)
+    seed = guards.seed("workspace seed", seed)
+    reach = geometry.max_reach
+    guards.grid_cells("workspace planar grid cells", 2 * reach, cell, 2)
+    if 2 * reach / voxel_size + 2 > 2**20:  # voxel indices (per axis cubed) must fit an int64
+        raise OutOfRangeError(
+            "workspace voxel_size", voxel_size, f">= {2 * reach / 2**20:.3g} m for this arm"
+        )
+    return samples, seed
+
+
 def estimate_workspace(
     geometry: ArmGeometry,
     limits: JointLimits,
@@ -169,23 +198,9 @@ def estimate_workspace(
     Raises:
         InputError: for a non-positive sample count, voxel or cell size.
     """
-    if samples < 1:
-        raise InputError(f"workspace: samples must be >= 1. Got: {samples}")
-    for name, value in (("voxel_size", voxel_size), ("cell", cell)):
-        if not (math.isfinite(value) and value > 0):
-            raise InputError(f"workspace: {name} must be a positive length in m. Got: {value}")
-    from lynxplan import guards
-
-    samples = guards.count("workspace samples", samples)
-    guards.positive_length("workspace voxel_size", voxel_size)
-    guards.positive_length("workspace cell", cell)
-    rng = np.random.default_rng(guards.seed("workspace seed", seed))
+    samples, seed = checked_inputs(geometry, samples, voxel_size, cell, seed)
+    rng = np.random.default_rng(seed)
     reach = geometry.max_reach
-    guards.grid_cells("workspace planar grid cells", 2 * reach, cell, 2)
-    if 2 * reach / voxel_size + 2 > 2**20:  # voxel indices (per axis cubed) must fit an int64
-        raise OutOfRangeError(
-            "workspace voxel_size", voxel_size, f">= {2 * reach / 2**20:.3g} m for this arm"
-        )
     n_cells = math.ceil(2 * reach / cell) + 2
     planar_counts = np.zeros((n_cells, n_cells), dtype=bool)  # (z, signed r) over [-reach, reach]
     voxels: set[int] = set()

@@ -163,16 +163,8 @@ def estimate_workspace_on_dask(
     """
     from lynxplan.arm import workspace as serial
 
-    samples = guards.count("workspace samples", samples)
-    guards.positive_length("workspace voxel_size", voxel_size)
-    guards.positive_length("workspace cell", cell)
-    seed = guards.seed("workspace seed", seed)
+    samples, seed = serial.checked_inputs(geometry, samples, voxel_size, cell, seed)
     reach = geometry.max_reach
-    guards.grid_cells("workspace planar grid cells", 2 * reach, cell, 2)
-    if 2 * reach / voxel_size + 2 > 2**20:
-        raise OutOfRangeError(
-            "workspace voxel_size", voxel_size, f">= {2 * reach / 2**20:.3g} m for this arm"
-        )
     parts = _chunks(samples, AL5_CHUNK, keep, 0)
     with open_client(cluster) as client:
         geometry_f, limits_f = client.scatter([geometry, limits], broadcast=True)
