@@ -1,10 +1,13 @@
 """Shared fixtures: models are loaded once per session.
 
-On a cold numba cache (a clean clone: CI), a background process compiles the heaviest kernels
-(the SO-101's IK and the planner, through ``lynxplan compile``'s own workloads) on the second
-core while the first tests run, so that the tests which need them later load them from numba's
-cache instead of compiling them one after the other on one core. It changes no result (the
-same kernels, the same single signature each; ``tests/test_kernel_signatures.py`` checks it).
+On a cold numba cache (a clean clone: CI), the kernels are compiled before the tests run, by
+``lynxplan compile``'s own workloads: under ``pytest -n`` (the README's test command) in two
+processes at once, each on a core, while the test session waits; otherwise in one background
+process on the second core while the first tests run. Either way the tests load the kernels
+from numba's cache instead of compiling them each in its own process, the same kernel in two
+workers at once (measured on the 2-core machine: five Dask tests took 2-4 min each, compiling
+what the other worker was compiling too). It changes no result (the same kernels, the same
+single signature each; ``tests/test_kernel_signatures.py`` checks it).
 ``LYNXPLAN_TEST_PRECOMPILE=0`` turns it off; the tests that measure a first run use caches of
 their own (``NUMBA_CACHE_DIR``).
 """
@@ -14,45 +17,69 @@ from __future__ import annotations
 import os
 import subprocess
 import sys
+import time
+from pathlib import Path
 
 import pytest
 from hypothesis import settings
 
 from lynxplan.arm import Arm, load_arm
 
+REPO = Path(__file__).resolve().parents[1]
+# The commands the tests start (``lynxplan ...``, ``python -c``) import this checkout, the code
+# under test, as pytest does (``pythonpath``), not a copy installed into the venv by ``pip
+# install .``: the same code, and the same numba cache (an installed copy compiles every kernel
+# again, measured in CI: 2-3 min of two tests). The tests of the installed wheel
+# (``wheel_venv.py``) clear PYTHONPATH for theirs.
+os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO), os.environ.get("PYTHONPATH")]))
+
 # Property tests draw the same examples on every run (no flaky CI); deadlines off because the
 # first call of a numba kernel compiles or loads it.
 settings.register_profile("lynxplan", derandomize=True, deadline=None)
 settings.load_profile("lynxplan")
 
-#: ``lynxplan compile`` stages compiled in the background on a cold cache, in this order (the
-#: SO-101's IK is first needed by the benchmark-suite and fan-out tests, the planner next).
+#: ``lynxplan compile`` stages compiled in the background on a cold cache (a run without ``-n``),
+#: in this order (the SO-101's IK is first needed by the benchmark-suite and fan-out tests, the
+#: planner next).
 PRECOMPILE = ("IK (SO-101)", "plan (AL5)", "plan (SO-101)")
+#: Under ``pytest -n``: the SO-101's IK (about half of all the compiling) in one process, every
+#: other stage in the other.
+FIRST = ("IK (SO-101)",)
 _PRECOMPILE_CODE = (
     "import sys\n"
     "from lynxplan.commands.compile import STAGES\n"
     "stages = dict(STAGES)\n"
-    "for name in sys.argv[1:]:\n"
+    f"for name in sys.argv[1:] or [n for n in stages if n not in {set(FIRST)!r}]:\n"
     "    stages[name]()\n"
 )
 _background: list[subprocess.Popen[bytes]] = []
 
 
+def _compile(*stages: str) -> subprocess.Popen[bytes]:
+    return subprocess.Popen(
+        [sys.executable, "-c", _PRECOMPILE_CODE, *stages],
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.DEVNULL,
+        start_new_session=True,
+    )
+
+
 def pytest_sessionstart(session: pytest.Session) -> None:
-    if os.environ.get("LYNXPLAN_TEST_PRECOMPILE", "1") == "0":
+    off = os.environ.get("LYNXPLAN_TEST_PRECOMPILE", "1") == "0"
+    if off or "PYTEST_XDIST_WORKER" in os.environ:
         return
     from lynxplan import _jit
 
     if not _jit.cold_kernels():
         return
-    _background.append(
-        subprocess.Popen(
-            [sys.executable, "-c", _PRECOMPILE_CODE, *PRECOMPILE],
-            stdout=subprocess.DEVNULL,
-            stderr=subprocess.DEVNULL,
-            start_new_session=True,
-        )
-    )
+    if not getattr(session.config.option, "numprocesses", None):
+        _background.append(_compile(*PRECOMPILE))
+        return
+    began = time.perf_counter()
+    processes = [_compile(*FIRST), _compile()]
+    codes = [process.wait() for process in processes]
+    print(f"\nlynxplan: compiled the numba kernels first ({time.perf_counter() - began:.0f} s, "
+          f"two processes; exit codes {codes})", flush=True)  # fmt: skip
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:

@@ -18,11 +18,11 @@ Conventions the README is written to:
 - The set-up commands are recognised and not run (the test session did them: built the wheel
   and installed it): ``git clone``, ``cd lynxplan``, ``python -m venv``, ``pip install`` (any
   ``pip``/``python -m pip``), ``source``/``.`` of an activate script, ``.ci/run``, and the test
-  command (``pytest`` with options only or on ``tests``). A chain ``a && b && c`` runs without
-  its leading set-up commands (``python -m venv .venv && .venv/bin/pip install . &&
-  .venv/bin/lynxplan run ...`` runs the ``lynxplan run``), except the test recipe: a chain
-  holding the test command is not run. ``pytest scenarios/`` (the plugin on the user's
-  scenarios) runs.
+  command (``pytest`` with options only, ``-n auto`` too, or on ``tests``). A chain
+  ``a && b && c`` runs without its leading set-up commands (``python -m venv .venv &&
+  .venv/bin/pip install . && .venv/bin/lynxplan run ...`` runs the ``lynxplan run``), except
+  the test recipe: a chain holding the test command is not run. ``pytest scenarios/`` (the
+  plugin on the user's scenarios) runs.
 - ``lynxplan serve ...`` starts as a process: it must print its URL on stdout within
   :data:`SERVE_TIMEOUT` seconds; ``GET <url>/health`` must answer 200; the server keeps running
   for the rest of its block (a later ``--server URL`` line may use it) and is then terminated.
@@ -56,9 +56,10 @@ _EXIT = re.compile(r"#.*?\bexit\s+(\d+(?:\s*(?:or|,|\|)\s*\d+)*)")
 _SETUP = re.compile(
     r"^(git\s+clone|cd\s+lynxplan\b|(\S*/)?python3?\s+-m\s+(venv|pip\s+install)\b"
     r"|(\S*/)?pip3?\s+install\b|source\s|\.\s+\S*activate|(\./)?\.ci/run\b"
-    r"|(\S*/)?pytest(\s+(-\S+|tests\S*))*\s*$|(\S*/)?python3?\s+-m\s+pytest(\s+(-\S+|tests\S*))*\s*$)"
+    r"|(\S*/)?pytest(\s+(-n\s+\w+|-\S+|tests\S*))*\s*$"
+    r"|(\S*/)?python3?\s+-m\s+pytest(\s+(-n\s+\w+|-\S+|tests\S*))*\s*$)"
 )
-_TEST = re.compile(r"^(\S*/)?(pytest|python3?\s+-m\s+pytest)(\s+(-\S+|tests\S*))*\s*$")
+_TEST = re.compile(r"^(\S*/)?(pytest|python3?\s+-m\s+pytest)(\s+(-n\s+\w+|-\S+|tests\S*))*\s*$")
 _URL = re.compile(r"https?://[^\s'\"<>]+")
 
 
@@ -313,7 +314,7 @@ _FAKE = """\
 
 ```sh
 pip install .                     # set-up: not run
-python -m venv .venv && .venv/bin/pip install '.[test]' && .venv/bin/pytest -q
+python -m venv .venv && .venv/bin/pip install '.[test]' && .venv/bin/pytest -q -n auto
 python3 -m venv .venv && pip install . && echo ran > ran.txt
 echo hello > greeting.txt         # a comment
 test -f greeting.txt
@@ -345,7 +346,7 @@ def test_the_harness_runs_a_truthful_readme(runner: Runner) -> None:
     found = blocks(_FAKE)
     assert [b.language for b in found] == ["sh", "yaml", "python"]
     skipped = [s for b in found for s in runner.run_block(b)]
-    chain = "python -m venv .venv && .venv/bin/pip install '.[test]' && .venv/bin/pytest -q"
+    chain = "python -m venv .venv && .venv/bin/pip install '.[test]' && .venv/bin/pytest -q -n auto"
     assert skipped == ["README.md:4: pip install .", f"README.md:5: {chain}"]
     assert (runner.folder / "greeting.txt").read_text() == "hello\n"
     assert (runner.folder / "ran.txt").read_text() == "ran\n"  # the chain less its set-up
