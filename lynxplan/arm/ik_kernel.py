@@ -324,10 +324,12 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         common = (beta, q3_abs, q3_neg, q3_neg_in, q3_pos, q3_pos_in, lo2, hi2, lo4, hi4, tol)
         front = (q1_f, q1_f_in, q5_f, q5_f_in, phi_front, q234_front)
         back = (q1_b, q1_b_in, q5_b, q5_b_in, phi_back, -q234_front)
-        _branch(s, i, 0, front, r_w >= 0.0, common, solved)  # elbow up: q3 < 0 ahead
-        _branch(s, i, 1, front, r_w < 0.0, common, solved)
-        _branch(s, i, 2, back, -r_w >= 0.0, common, solved)
-        _branch(s, i, 3, back, -r_w < 0.0, common, solved)
+        # branches 0, 1 ahead, 2, 3 behind; even: elbow up (q3 < 0 ahead). A loop, not four
+        # calls: numba inlines _branch once (a quarter of its compile); LLVM unrolls it.
+        for b in range(4):
+            w = r_w if b < 2 else -r_w
+            _branch(s, i, b, front if b < 2 else back, w >= 0.0 if b % 2 == 0 else w < 0.0,
+                    common, solved)  # fmt: skip
         # Step 5: the residual. The reached approach a_s; approach targets: its angle to the
         # target's; full poses: the reached n and o axes (the same for every branch, before any
         # snapping onto a limit) and the angle of R_t^T R_s.
