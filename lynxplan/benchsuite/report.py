@@ -37,8 +37,9 @@ class GroupSummary:
     """The figures of one robot and family (``family`` "all": the robot's whole suite).
 
     Attributes:
-        problems: How many problems; ``solved``: how many got a path; ``clean``: how many of
-            those passed the dense check.
+        problems: How many problems; ``solved``: how many got a path within the node budget;
+            ``in_time``: how many of those within the time limit (``runner.TIME_LIMIT``, the
+            goal's); ``clean``: how many of those solved passed the dense check.
         plan, simplify, total: Times in [s]; ``raw_length``, ``length``: joint-space path
             lengths before and after simplification, in [rad].
     """
@@ -47,6 +48,7 @@ class GroupSummary:
     family: str
     problems: int
     solved: int
+    in_time: int
     clean: int
     plan: Spread
     simplify: Spread
@@ -72,6 +74,7 @@ def _summary(robot: str, family: str, results: list[ProblemResult]) -> GroupSumm
         family,
         len(results),
         len(solved),
+        sum(r.solved_in_time for r in solved),
         sum(r.clean for r in solved),
         Spread.of([r.plan_time for r in solved]),
         Spread.of([r.simplify_time for r in solved]),
@@ -89,12 +92,13 @@ def table(summaries: Sequence[GroupSummary]) -> str:
     """The table: one line per robot and family, times in [ms] (median p95 max), lengths in
     [rad] (median before -> after simplification)."""
     head = (
-        f"{'robot':<6} {'family':<12} {'solved':>8} {'clean':>6} | {'plan ms: med p95 max':>24} |"
+        f"{'robot':<6} {'family':<12} {'solved':>8} {'<= 1 s':>6} {'clean':>6} |"
+        f" {'plan ms: med p95 max':>24} |"
         f" {'simplify ms: med p95 max':>24} | {'total ms: med p95 max':>24} | length rad"
     )
     lines = [head, "-" * len(head)]
     lines += [
-        f"{s.robot:<6} {s.family:<12} {s.solved:>3}/{s.problems:<4} {s.clean:>6} | "
+        f"{s.robot:<6} {s.family:<12} {s.solved:>3}/{s.problems:<4} {s.in_time:>6} {s.clean:>6} | "
         f"{_ms(s.plan)} | {_ms(s.simplify)} | {_ms(s.total)} | "
         f"{s.raw_length.median:5.2f} -> {s.length.median:5.2f}"
         for s in summaries
@@ -122,8 +126,8 @@ def goal_misses(summaries: Sequence[GroupSummary]) -> list[str]:
     """The issue's goals (solved, clean, median total) each robot misses, one line each."""
     misses = []
     for s in (s for s in summaries if s.family == "all"):
-        if s.solved < GOAL_SOLVED * s.problems:
-            misses.append(f"{s.robot}: {s.solved}/{s.problems} solved (goal >= 99 %)")
+        if s.in_time < GOAL_SOLVED * s.problems:
+            misses.append(f"{s.robot}: {s.in_time}/{s.problems} solved within 1 s (goal >= 99 %)")
         if s.clean < GOAL_CLEAN * s.solved:
             misses.append(f"{s.robot}: {s.clean}/{s.solved} clean (goal 100 %)")
         if not s.total.median <= GOAL_MEDIAN_TOTAL:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from lynxplan.benchsuite import runner
 from lynxplan.benchsuite.problem import suite_robot
 from lynxplan.benchsuite.runner import DENSE_STEP, dense_check, densify, run_problem
 from lynxplan.benchsuite.storage import load_shipped
@@ -32,6 +33,21 @@ def test_planned_path_is_clean_and_figures_are_consistent() -> None:
     # the straight motion of the same problem is not clean for the same check
     straight = np.stack([problem.start, problem.goal])
     assert dense_check(suite_robot("al5"), problem, straight) < 0.0
+
+
+def test_the_node_budget_decides_solved_not_the_clock(monkeypatch) -> None:
+    """A budget too small for the problem fails it by the node limit, the same way every time,
+    however much wall-clock time is left; the issue's "within 1 s" is read off the times."""
+    (problem,) = [p for p in load_shipped("al5") if p.name == "al5_cage_003"]  # ~270 nodes
+    monkeypatch.setattr(runner, "NODE_BUDGET", 20)
+    first, second = run_problem(problem), run_problem(problem)
+    assert not first.solved and "node limit 20 reached" in first.reason
+    assert first.outcome() == second.outcome() and 0 < first.nodes <= 2 * 20 + 2
+    assert not first.solved_in_time
+    monkeypatch.undo()
+    solved = run_problem(problem)
+    assert solved.solved and solved.nodes > 40
+    assert solved.solved_in_time == (solved.total_time <= runner.TIME_LIMIT)
 
 
 def _lynxplan() -> str:
