@@ -228,7 +228,10 @@ def estimate_workspace(
         if progress is not None:
             progress(done, samples)
     centres = (np.arange(n_cells) + 0.5) * cell - reach
-    planar_member = _refine_boundary(planar_counts, centres, geometry, limits, cell)
+    step = membership_step(geometry, cell)
+    planar_member = refine_boundary(
+        planar_counts, centres, lambda points: exact_membership(points, geometry, limits, step)
+    )
     sweep = float(limits.upper[0] - limits.lower[0])
     # Revolution volume (midpoint rule): sweep * sum over member cells of |r| * cell^2.
     volume_revolution = sweep * float((planar_member * np.abs(centres)[None, :]).sum()) * cell**2
@@ -253,27 +256,43 @@ def _shifted_any(mask: np.ndarray, radius: int) -> np.ndarray:
     return np.asarray(out)
 
 
-def _refine_boundary(
+def refine_boundary(
     sampled: np.ndarray,
     centres: np.ndarray,
-    geometry: ArmGeometry,
-    limits: JointLimits,
-    cell: float,
+    membership: Callable[[np.ndarray], np.ndarray],
 ) -> np.ndarray:
     """Planar membership at cell centres: sampled interior cells are kept, and every cell near
-    the sampled boundary (or in a sampling hole) is decided by the exact membership test."""
+    the sampled boundary (or in a sampling hole) is decided by the exact membership test.
+
+    Args:
+        sampled: (nz, nr) bool, the cells a sample fell in.
+        centres: (n,) cell centres along r and z, in [m].
+        membership: The exact test of planar points (k, 2) (r, z) [m] -> (k,) bool
+            (:func:`exact_membership`, or the same in chunks on a Dask cluster).
+    """
     interior = ~_shifted_any(~sampled, 1)
     candidates = _shifted_any(sampled, 2) & ~interior
     iz, ir = np.nonzero(candidates)
-    points = np.column_stack((centres[ir], centres[iz]))
-    member = np.empty(points.shape[0], dtype=np.bool_)
-    step = 0.5 * cell / geometry.d5
-    planar_membership_kernel(
-        points, geometry.a2, geometry.a3, geometry.d5, limits.lower, limits.upper, step, member
-    )
+    member = membership(np.column_stack((centres[ir], centres[iz])))
     result: np.ndarray = interior.copy()
     result[iz[member], ir[member]] = True
     return result
+
+
+def membership_step(geometry: ArmGeometry, cell: float) -> float:
+    """The exact membership test's wrist-angle step [rad] for cells of ``cell`` [m]."""
+    return 0.5 * cell / geometry.d5
+
+
+def exact_membership(
+    points: np.ndarray, geometry: ArmGeometry, limits: JointLimits, step: float
+) -> np.ndarray:
+    """:func:`planar_membership_kernel` of planar points (k, 2) (r, z) [m]: (k,) bool."""
+    member = np.empty(points.shape[0], dtype=np.bool_)
+    planar_membership_kernel(
+        points, geometry.a2, geometry.a3, geometry.d5, limits.lower, limits.upper, step, member
+    )
+    return member
 
 
 def _fold_envelope(planar: np.ndarray, cell: float, reach: float) -> Envelope:

@@ -106,32 +106,23 @@ def _robot_chunk(part: tuple[int, int, int], robot: Any, seed: int,
 
 
 def _membership_chunk(points: np.ndarray, geometry: Any, limits: Any, step: float) -> np.ndarray:
-    """:func:`lynxplan.arm.workspace.planar_membership_kernel` of planar points (k, 2) [m]."""
-    from lynxplan.arm.workspace import planar_membership_kernel
+    """:func:`lynxplan.arm.workspace.exact_membership` of planar points (k, 2) [m]."""
+    from lynxplan.arm.workspace import exact_membership
 
-    member = np.empty(points.shape[0], dtype=np.bool_)
-    planar_membership_kernel(points, geometry.a2, geometry.a3, geometry.d5,
-                             limits.lower, limits.upper, step, member)  # fmt: skip
-    return member
+    return exact_membership(points, geometry, limits, step)
 
 
-def _refine_boundary(client: Any, sampled: np.ndarray, centres: np.ndarray, geometry: Any,
-                     limits: Any, step: float) -> np.ndarray:  # fmt: skip
-    """The serial ``_refine_boundary`` of :mod:`lynxplan.arm.workspace` (the same cells, the
-    same exact test), its exact membership tests (most of the serial sweep's time: 2.3 of 4.5 s
-    at 2e6 samples and 1 mm cells) in chunks on the cluster."""
-    from lynxplan.arm.workspace import _shifted_any
+def _membership_on(client: Any, geometry: Any, limits: Any, step: float) -> Any:
+    """The exact membership test (most of the serial sweep's time: 2.3 of 4.5 s at 2e6 samples
+    and 1 mm cells) in chunks on the cluster, for :func:`lynxplan.arm.workspace.refine_boundary`
+    (geometry and limits: their futures)."""
 
-    interior = ~_shifted_any(~sampled, 1)
-    candidates = _shifted_any(sampled, 2) & ~interior
-    iz, ir = np.nonzero(candidates)
-    points = np.column_stack((centres[ir], centres[iz]))
-    parts = np.array_split(points, max(1, min(MEMBERSHIP_TASKS, points.shape[0] // 1000)))
-    member = np.concatenate(map_chunks(client, _membership_chunk, parts, geometry=geometry,
-                                       limits=limits, step=step))  # fmt: skip
-    result: np.ndarray = interior.copy()
-    result[iz[member], ir[member]] = True
-    return result
+    def membership(points: np.ndarray) -> np.ndarray:
+        parts = np.array_split(points, max(1, min(MEMBERSHIP_TASKS, points.shape[0] // 1000)))
+        return np.concatenate(map_chunks(client, _membership_chunk, parts, geometry=geometry,
+                                         limits=limits, step=step))  # fmt: skip
+
+    return membership
 
 
 def _merge(parts: list[ChunkReduction]) -> tuple[int, float, float, float, np.ndarray]:
@@ -174,8 +165,10 @@ def estimate_workspace_on_dask(
         )  # fmt: skip
         planar = np.logical_or.reduce([p.planar for p in done])
         centres = (np.arange(planar.shape[0]) + 0.5) * cell - reach
-        member = _refine_boundary(client, planar, centres, geometry_f, limits_f,
-                                  0.5 * cell / geometry.d5)  # fmt: skip
+        step = serial.membership_step(geometry, cell)
+        member = serial.refine_boundary(
+            planar, centres, _membership_on(client, geometry_f, limits_f, step)
+        )
     voxel_count, max_reach, z_min, z_max, kept = _merge(done)
     sweep = float(limits.upper[0] - limits.lower[0])
     volume_revolution = sweep * float((member * np.abs(centres)[None, :]).sum()) * cell**2
