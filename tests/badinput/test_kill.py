@@ -13,6 +13,8 @@ from pathlib import Path
 
 import pytest
 
+from lynxplan.scenarios.folders import MARKER
+
 REPO = Path(__file__).resolve().parents[2]
 _CLI = "import sys; from lynxplan.cli import main; raise SystemExit(main(sys.argv[1:]))"
 
@@ -43,11 +45,14 @@ def _debris(parent: Path, name: str) -> list[str]:
 
 def _kill_while_writing(process: subprocess.Popen[str], parent: Path, name: str) -> bool:
     """SIGKILL ``process`` as soon as its staging folder holds an output (its manifest, written
-    when the folder is made, does not count); False if it ended first."""
+    when the folder is made through a temporary file, does not count: a kill between the two
+    leaves a folder with no manifest, which lynxplan rightly never removes); False if it ended
+    first."""
     deadline = time.monotonic() + 120.0
+    manifest = (MARKER, f"{MARKER}.partial")
     while time.monotonic() < deadline and process.poll() is None:
         for staging in parent.glob(f".{name}.staging-*"):
-            if any(p.is_file() and p.name != ".lynxplan-output" for p in staging.rglob("*")):
+            if any(p.is_file() and p.name not in manifest for p in staging.rglob("*")):
                 process.send_signal(signal.SIGKILL)
                 process.communicate(timeout=30)
                 return True
