@@ -64,6 +64,25 @@ def _compile(*stages: str) -> subprocess.Popen[bytes]:
     )
 
 
+#: Test files whose tests build on each other's files (the README's blocks run in order in one
+#: folder): under ``pytest -n`` each runs whole, in order, on one worker.
+IN_ORDER_FILES = ("tests/test_readme.py",)
+
+
+def pytest_xdist_make_scheduler(config: pytest.Config, log: object) -> object:
+    """Under ``pytest -n``: spread tests one by one (balance on 2 cores), except the files of
+    :data:`IN_ORDER_FILES`, each kept whole on one worker (xdist's ``loadgroup`` marker is
+    ignored under pytest 9.2, so the grouping is this scheduler's scope)."""
+    from xdist.scheduler import LoadScopeScheduling
+
+    class InOrderFilesScheduling(LoadScopeScheduling):
+        def _split_scope(self, nodeid: str) -> str:
+            path = nodeid.split("::", 1)[0]
+            return path if path in IN_ORDER_FILES else nodeid
+
+    return InOrderFilesScheduling(config, log)
+
+
 def pytest_sessionstart(session: pytest.Session) -> None:
     off = os.environ.get("LYNXPLAN_TEST_PRECOMPILE", "1") == "0"
     if off or "PYTEST_XDIST_WORKER" in os.environ:
