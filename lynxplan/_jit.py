@@ -43,7 +43,7 @@ ENTRY_KERNELS = (
     "lynxplan.arm.ik_select:ik_single_kernel",
     "lynxplan.robots.ik.family_kernel:family_ik_kernel",
     "lynxplan.robots.ik.pose_kernel:pose_kernel",
-    "lynxplan.robots.ik.pose_block:pose_block_kernel",
+    "lynxplan.robots.ik.pose_block:blocks",
     "lynxplan.planning.rrt_connect:rrt_connect_begin",
     "lynxplan.planning.rrt_connect:rrt_connect_kernel",
     "lynxplan.planning.shortcut:shortcut_path",

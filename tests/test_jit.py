@@ -24,6 +24,40 @@ def test_compile_before_timing_compiles_once_without_running() -> None:
     assert twice(2.5) == 5.0
 
 
+
+def test_a_constant_flag_prunes_the_other_branch_before_it_is_compiled() -> None:
+    """The mechanism of ``robots/ik/pose_block``'s variants: a kernel called with a constant
+    ``True`` or ``None`` for a flag compiles only the callee of its ``is None`` branch (numba
+    prunes such branches when it compiles: a plain ``bool`` flag would compile both)."""
+
+    @numba.njit
+    def on_axis(x: float) -> float:
+        return x + 1.0
+
+    @numba.njit
+    def off_axis(x: float) -> float:
+        return x + 2.0
+
+    @numba.njit
+    def kernel(x: float, flag: bool | None) -> float:
+        if flag is None:
+            return on_axis(x)
+        return off_axis(x)
+
+    @numba.njit
+    def variant_off(x: float) -> float:
+        return kernel(x, True)
+
+    assert variant_off(1.0) == 3.0
+    assert off_axis.signatures and not on_axis.signatures
+
+    @numba.njit
+    def variant_on(x: float) -> float:
+        return kernel(x, None)
+
+    assert variant_on(1.0) == 2.0
+    assert on_axis.signatures
+
 ANNOUNCE = """
 import io, sys
 import numba

@@ -345,6 +345,23 @@ def elbow_terms(
     return (sigma[1] * s_q2, sigma[2] * s_q3, sigma[3] * s_q4), (c_q2, c_q3, c_q4)
 
 
+@numba.njit(cache=True, nogil=True)
+def solve_closed_forms(
+    pr: Floats, shape: Floats, x: np.ndarray, m: int, off_axis: bool | None
+) -> None:
+    """The block's closed forms (the first m poses' count): ``closed_forms_on_roll_axis`` where
+    the tool point is on the roll axis (``off_axis`` None), else ``closed_forms`` and, for the
+    poses it marks, ``other_flip``. numba prunes the ``is None`` branch when it compiles: only
+    the one an arm needs is compiled."""
+    if off_axis is None:
+        closed_forms_on_roll_axis(pr, shape, x)
+    else:
+        closed_forms(pr, shape, x)
+        for i in range(m):  # the other flip where it may matter (rare: see screen_flips)
+            if x[POSE.other * BLOCK + i] != 0.0:
+                other_flip(pr, shape, x, i)
+
+
 @numba.njit(cache=True, nogil=True, fastmath=FAST, error_model="numpy")
 def closed_forms(pr: Floats, shape: Floats, x: np.ndarray) -> None:
     """``closed_forms_of`` for a tool point off the roll axis (``F.OFF_AXIS`` not 0)."""

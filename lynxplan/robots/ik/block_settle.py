@@ -119,10 +119,11 @@ def polish_settle_all_parallel(m: int, pr: Floats, ch: Floats, c: np.ndarray) ->
 
 
 @numba.njit(cache=True, nogil=True)
-def polish_settle(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel: bool) -> None:
-    """``polish_settle_all_parallel`` where the pitch axes are parallel, else
-    ``polish_settle_all`` (one compiled loop each)."""
-    if parallel:
+def polish_settle(m: int, pr: Floats, ch: Floats, c: np.ndarray, ldl: bool | None) -> None:
+    """``polish_settle_all_parallel`` where the pitch axes are parallel (``ldl`` None), else
+    ``polish_settle_all`` (``ldl`` True). numba prunes the ``is None`` branch when it compiles:
+    only the one an arm needs is compiled."""
+    if ldl is None:
         polish_settle_all_parallel(m, pr, ch, c)
     else:
         polish_settle_all(m, pr, ch, c)
@@ -176,13 +177,13 @@ def repolish(
     c_flat: np.ndarray,
     c2_flat: np.ndarray,
     index: np.ndarray,
-    parallel: bool,
+    ldl: bool | None,
 ) -> None:
     """The m candidates in the rows c_flat that the polish left unfinished next to a branch
     (final errors below BLOCK_NOT_A_BRANCH: next to a fold of the elbow the steps converge
     slowly) polished once more from where they stopped, gathered into the rows c2_flat (whole
     vectors): those that reach VECTOR_EXACT are taken, the others stay with the scalar polish
-    (from their closed-form start)."""
+    (from their closed-form start). ldl: the Newton step, as in ``polish_settle``."""
     c, c2 = (
         c_flat.reshape((CANDIDATE.rows, CANDIDATE_WIDTH)),
         c2_flat.reshape((CANDIDATE.rows, CANDIDATE_WIDTH)),
@@ -206,7 +207,7 @@ def repolish(
             c2[CANDIDATE.sines + row, j], c2[CANDIDATE.cosines + row, j] = sincos(
                 c2[CANDIDATE.q + row, j]
             )
-    polish_settle(lanes, pr, ch, c2_flat, parallel)
+    polish_settle(lanes, pr, ch, c2_flat, ldl)
     for j in range(count):
         if c2[CANDIDATE.taken, j] == 0.0:
             continue

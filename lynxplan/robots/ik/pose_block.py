@@ -42,6 +42,8 @@ order, so both give the same branches (angles equal to ~1e-10 rad).
 
 from __future__ import annotations
 
+from typing import Any, NamedTuple
+
 import numba
 import numpy as np
 from numba.np.unsafe.ndarray import to_fixed_tuple
@@ -49,12 +51,7 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 from lynxplan._fastmath import prefetch, prefetch_write, wide_vectors
 from lynxplan.constants import BRANCH_DUPLICATE_TOLERANCE, POSE_EXACT
 from lynxplan.robots import family as F  # noqa: N812
-from lynxplan.robots.ik.block_closed_form import (
-    closed_forms,
-    closed_forms_on_roll_axis,
-    flip_branches,
-    other_flip,
-)
+from lynxplan.robots.ik.block_closed_form import flip_branches, solve_closed_forms
 from lynxplan.robots.ik.block_layout import (
     ALL_TAKEN,
     BLOCK,
@@ -81,13 +78,23 @@ from lynxplan.robots.ik.pose_kernel import (
 )
 from lynxplan.robots.results import BranchSlots
 
-__all__ = ["BLOCK", "pose_block_kernel"]
+__all__ = ["BLOCK", "blocks", "pose_block_kernel"]
 
 N_PARAMS = F.N_PARAMS  # a global: numba takes it as the constant to_fixed_tuple needs
 
 
-@numba.njit(cache=True, nogil=True)
-def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
+class FamilyArrays(NamedTuple):
+    """A family arm as the kernels read it."""
+
+    packed: np.ndarray
+    """The family's parameters, ``Family.packed`` (F.N_PARAMS,)."""
+    placements: np.ndarray
+    """The exact chain's joint placements (5, 4, 4) [m]."""
+    axes: np.ndarray
+    """The exact chain's joint axes (5, 3)."""
+
+
+def pose_block_kernel(
     prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,
@@ -99,20 +106,91 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
 ) -> int:
     """``pose_kernel`` (same arguments and outputs), by blocks of BLOCK vectorised poses with
     the scalar ``solve_target`` for the poses that need it and the scalar polish for the
-    candidates that need it. Returns how many poses needed either.
+    candidates that need it (:func:`blocks`, compiled with this arm's closed form and Newton
+    step only). Returns how many poses needed either.
 
     targets: (N, 4, 4) rigid poses; reference (N, 5) or (1, 5) [rad]; outputs (N, B, ...), every
     slot written; solved (N,): an exact branch was found; distance (N,): the smallest position
     error over the slots [m].
     """
+    kernel = _variant(prm, placements, axes)
+    done: int = kernel(
+        FamilyArrays(prm, placements, axes), targets, reference, slots, solved, distance
+    )
+    return done
+
+
+def _variant(prm: np.ndarray, placements: np.ndarray, axes: np.ndarray) -> Any:
+    """The variant of :func:`blocks` for this arm (:data:`_VARIANTS`), remembered per arm (the
+    test builds a chain tuple: ~10 us, a fifth of a 64-pose batch)."""
+    key = (prm.tobytes(), placements.tobytes(), axes.tobytes())
+    kernel = _CHOSEN.get(key)
+    if kernel is None:
+        if len(_CHOSEN) >= 64:  # bounded: a service may load many arms
+            _CHOSEN.clear()
+        off_axis = bool(prm[F.OFF_AXIS] != 0.0)
+        ldl = not parallel_pitches(chain_tuple(placements, axes))
+        kernel = _CHOSEN[key] = _VARIANTS[off_axis, ldl]
+    return kernel
+
+
+# The four variants of :func:`blocks`, its flags constants: numba prunes an ``is None`` branch
+# on a constant (or None) argument when it compiles, so an arm compiles only its own closed
+# form and Newton step (each ~30-50 s of compile on first use).
+@numba.njit(cache=True, nogil=True)
+def _on_axis_parallel(
+    arm: FamilyArrays, targets: np.ndarray, reference: np.ndarray, slots: BranchSlots,
+    solved: np.ndarray, distance: np.ndarray,
+) -> int:  # fmt: skip
+    return blocks(arm, targets, reference, slots, solved, distance, None, None)
+
+
+@numba.njit(cache=True, nogil=True)
+def _on_axis_ldl(
+    arm: FamilyArrays, targets: np.ndarray, reference: np.ndarray, slots: BranchSlots,
+    solved: np.ndarray, distance: np.ndarray,
+) -> int:  # fmt: skip
+    return blocks(arm, targets, reference, slots, solved, distance, None, True)
+
+
+@numba.njit(cache=True, nogil=True)
+def _off_axis_parallel(
+    arm: FamilyArrays, targets: np.ndarray, reference: np.ndarray, slots: BranchSlots,
+    solved: np.ndarray, distance: np.ndarray,
+) -> int:  # fmt: skip
+    return blocks(arm, targets, reference, slots, solved, distance, True, None)
+
+
+@numba.njit(cache=True, nogil=True)
+def _off_axis_ldl(
+    arm: FamilyArrays, targets: np.ndarray, reference: np.ndarray, slots: BranchSlots,
+    solved: np.ndarray, distance: np.ndarray,
+) -> int:  # fmt: skip
+    return blocks(arm, targets, reference, slots, solved, distance, True, True)
+
+
+@numba.njit(cache=True, nogil=True)
+def blocks(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
+    arm: FamilyArrays,
+    targets: np.ndarray,
+    reference: np.ndarray,
+    slots: BranchSlots,
+    solved: np.ndarray,
+    distance: np.ndarray,
+    off_axis: bool | None,
+    ldl: bool | None,
+) -> int:
+    """:func:`pose_block_kernel`'s work. ``off_axis``: None where the tool point is on the
+    roll axis (its closed form), else True; ``ldl``: None where the pitch axes are parallel
+    (``newton_parallel``'s steps), else True (``newton_ldl``'s). Both constants (see
+    ``_VARIANTS``)."""
     wide_vectors()
+    prm, placements, axes = arm.packed, arm.placements, arm.axes
     nb = slots.q.shape[1]
     per_side = nb // 2
     ch = chain_tuple(placements, axes)
-    parallel = parallel_pitches(ch)
     pr: Floats = to_fixed_tuple(prm, N_PARAMS)  # type: ignore[call-arg]
     exact = prm[F.EXACT] != 0.0
-    on_roll_axis = prm[F.OFF_AXIS] == 0.0
     shape = link_shape(prm)
     # the scratch rows and the candidate rows in one array (constant distances: ``closed_forms``)
     x_flat = np.zeros(POSE.rows * BLOCK + CANDIDATE.rows * CANDIDATE_WIDTH)
@@ -143,13 +221,7 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             for r in range(3):
                 for col in range(4):
                     s[4 * r + col, i] = targets[start + i, r, col]
-        if on_roll_axis:
-            closed_forms_on_roll_axis(pr, shape, x_flat)
-        else:
-            closed_forms(pr, shape, x_flat)
-            for i in range(m):  # the other flip where it may matter (rare: see screen_flips)
-                if s[POSE.other, i] != 0.0:
-                    other_flip(pr, shape, x_flat, i)
+        solve_closed_forms(pr, shape, x_flat, m, off_axis)
         # the candidates of the poses that need no fallback, in the scalar solver's order: lane
         # i the elbow up and lane BLOCK + i the elbow down of pose i's first candidate flip
         # (written by closed_forms), then the other flip where it is a candidate too (rare:
@@ -217,12 +289,12 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         if exact:
             settle_all(lanes, pr, ch, c_flat)
         else:
-            polish_settle(lanes, pr, ch, c_flat, parallel)
+            polish_settle(lanes, pr, ch, c_flat, ldl)
         for i in range(BLOCK):  # the lanes of no candidate (no flip, past m): nothing to finish
             if i >= m or owned[i] == 0:
                 c[CANDIDATE.fallback, i] = c[CANDIDATE.fallback, BLOCK + i] = 0.0
         if not exact:
-            repolish(mc, pr, ch, c_flat, c2_flat, slot_index, parallel)
+            repolish(mc, pr, ch, c_flat, c2_flat, slot_index, ldl)
         clear_slots(start * nb, (start + m) * nb, q_flat, valid_flat, within_flat, p_flat, o_flat)
         for i in range(m):
             n = start + i
@@ -320,3 +392,14 @@ def pose_block_kernel(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
         solved[n] = solve_target(prm, placements, axes, targets[n], ref, out, scratch)
         write_slots(out, n, slots, distance)
     return fallbacks + deferred_count
+
+
+#: (tool off the roll axis, LDL^T steps) -> the variant of :func:`blocks` that an arm compiles.
+_VARIANTS = {
+    (False, False): _on_axis_parallel,
+    (False, True): _on_axis_ldl,
+    (True, False): _off_axis_parallel,
+    (True, True): _off_axis_ldl,
+}
+#: The variant of each arm seen (key: its arrays' bytes).
+_CHOSEN: dict[tuple[bytes, bytes, bytes], Any] = {}
