@@ -3,10 +3,13 @@
 from __future__ import annotations
 
 import ast
+import json
+import os
 import subprocess
 import sys
 
 import numba
+import numpy as np
 
 from lynxplan._jit import compile_before_timing
 
@@ -22,7 +25,6 @@ def test_compile_before_timing_compiles_once_without_running() -> None:
     assert [tuple(str(t) for t in s) for s in twice.signatures] == [("float64",)]
     assert compile_before_timing(twice, (2.5,)) == 0.0
     assert twice(2.5) == 5.0
-
 
 
 def test_a_constant_flag_prunes_the_other_branch_before_it_is_compiled() -> None:
@@ -57,6 +59,41 @@ def test_a_constant_flag_prunes_the_other_branch_before_it_is_compiled() -> None
 
     assert variant_on(1.0) == 2.0
     assert on_axis.signatures
+
+
+def test_lynxplan_runs_under_numbas_debugging_switch() -> None:
+    """With NUMBA_DISABLE_JIT=1 (numba's switch for debugging jitted code as Python) the
+    kernels run as Python and answer as compiled, to rounding: the first IK of an SO-101 pose,
+    roll free, position and approach, and the same through the command line."""
+    code = (
+        "import json, numpy as np, lynxplan; r = lynxplan.load_robot('so101');"
+        " q = np.array([0.3, -0.4, 0.9, 0.6, -1.2]); T = r.fk(q);"
+        " a = r.ik(T); b = r.ik(position=T[:3, 3], approach=T[:3, 2]);"
+        " print(json.dumps([a.q.tolist(), b.q.tolist()]))"
+    )
+    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
+    done = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=False
+    )
+    assert done.returncode == 0, done.stderr[-2000:]
+    interpreted = json.loads(done.stdout)
+    import lynxplan
+
+    robot = lynxplan.load_robot("so101")
+    pose = robot.fk(np.array([0.3, -0.4, 0.9, 0.6, -1.2]))
+    compiled = [
+        robot.ik(pose).q,
+        robot.ik(position=pose[:3, 3], approach=pose[:3, 2]).q,
+    ]
+    for got, want in zip(interpreted, compiled, strict=True):
+        np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+    cli = "import sys; from lynxplan.cli import main; sys.exit(main())"
+    command = [sys.executable, "-c", cli, "ik", "--robot", "so101",
+               "--position", "0.2", "0", "0.1", "--approach", "0", "0", "-1", "--json"]  # fmt: skip
+    shell = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
+    assert shell.returncode == 0, shell.stderr[-2000:]
+    assert json.loads(shell.stdout)["solutions"]
+
 
 ANNOUNCE = """
 import io, sys

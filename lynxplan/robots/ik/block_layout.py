@@ -35,8 +35,12 @@ FlipBranches = tuple[Floats, bool, bool, float, bool]
 Branches = tuple[Floats, Floats, Floats, Floats, Floats, Floats]
 # The branch-free sine/cosine and arctangent, inlined by LLVM rather than by numba: numba's own
 # inlining (``inline="always"``) of their ~40 call sites would multiply the compile time by 5.
-sincos = numba.njit(nogil=True, fastmath=FAST)(_fastmath.sincos.py_func)
-atan2 = numba.njit(nogil=True, fastmath=FAST)(_fastmath.atan2.py_func)
+# (Their Python functions: ``py_func``, or the functions themselves under numba's debugging
+# switch NUMBA_DISABLE_JIT, where a jitted function is the Python function.)
+sincos = numba.njit(nogil=True, fastmath=FAST)(
+    getattr(_fastmath.sincos, "py_func", _fastmath.sincos)
+)
+atan2 = numba.njit(nogil=True, fastmath=FAST)(getattr(_fastmath.atan2, "py_func", _fastmath.atan2))
 #: Poses per block (a constant width: the scratch rows never alias).
 BLOCK = 32
 #: The candidate loops run on a multiple of this many lanes (AVX-512: 8 doubles).
