@@ -102,6 +102,7 @@ def _al5_ik() -> None:
     """The AL5's IK entry points with the argument types the library passes them."""
     import numpy as np
 
+    import lynxplan
     from lynxplan.arm import Arm
     from lynxplan.arm.ik import solve_ik_batch
 
@@ -116,6 +117,7 @@ def _al5_ik() -> None:
     solve_ik_batch(batch, q_reference=q, limit_tolerance=0.0)
     batch.setflags(write=False)
     solve_ik_batch(batch)
+    lynxplan.load_robot("al5").ik(position=pose[:3, 3], pitch=1.0)  # the roll search
 
 
 def _so101_ik() -> None:

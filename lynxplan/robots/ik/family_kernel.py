@@ -54,7 +54,9 @@ __all__ = [
     "MODE_PITCH",
     "MODE_POSE",
     "ROOT_GRID",
+    "family_ik_exact",
     "family_ik_kernel",
+    "family_ik_near",
 ]
 
 
@@ -74,8 +76,7 @@ class KernelTargets(NamedTuple):
     approach is along the pitch axis, the roll where free and not determined."""
 
 
-@numba.njit(cache=True, nogil=True)
-def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per pose)
+def family_ik_kernel(
     prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,
@@ -94,6 +95,50 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
             [rad]; B = 4 (closed form) or 4 * MAX_ROOTS (root search).
         miss_out: (N, B) output: by how much the closed form missed the reach, [m].
     """
+    kernel = family_ik_exact if prm[F.EXACT] != 0.0 else family_ik_near
+    kernel(prm, placements, axes, goals, slots, miss_out)
+
+
+@numba.njit(cache=True, nogil=True)
+def family_ik_exact(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    goals: KernelTargets,
+    slots: BranchSlots,
+    miss_out: np.ndarray,
+) -> None:
+    """:func:`family_ik_kernel` for a model of the family exactly (the AL5): the Newton polish
+    and the exact chain's roll equation are not compiled (they never run for it)."""
+    _family_ik(prm, placements, axes, goals, slots, miss_out, None)
+
+
+@numba.njit(cache=True, nogil=True)
+def family_ik_near(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    goals: KernelTargets,
+    slots: BranchSlots,
+    miss_out: np.ndarray,
+) -> None:
+    """:func:`family_ik_kernel` for a model only close to the family (the SO-101)."""
+    _family_ik(prm, placements, axes, goals, slots, miss_out, True)
+
+
+@numba.njit(cache=True, nogil=True)
+def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per pose)
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    goals: KernelTargets,
+    slots: BranchSlots,
+    miss_out: np.ndarray,
+    near: bool | None,
+) -> None:
+    """:func:`family_ik_kernel`'s work. ``near``: None for a model of the family exactly, else
+    True (a constant: numba prunes the ``near is not None`` branches, the polish and the exact
+    roll equation, when it compiles the exact model's version)."""
     targets, mode, pitch, roll, reference = goals
     q_out, valid, within, position_error, orientation_error = slots
     nb = q_out.shape[1]
@@ -116,7 +161,6 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
     scratch5 = np.empty((6, 5))
     grid_x, grid_f = np.empty(GRID_SIZE), np.empty(GRID_SIZE)
     nearest = 0.0
-    exact = prm[F.EXACT] != 0.0
     off_axis = prm[F.OFF_AXIS] != 0.0
     for n in range(targets.shape[0]):
         target = targets[n]
@@ -159,7 +203,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
             if need_roots:
                 m = sample_roll_grid(problem, lo5, hi5, grid_x, grid_f)
                 count = roll_candidates(problem, grid_x, grid_f, m, roots)
-                if not exact:
+                if near is not None:
                     count = exact_candidates(
                         problem,
                         (
@@ -192,7 +236,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                     count, rooted = 1, False
                     nearest = nearest_roll(problem, grid_x, grid_f, m)
                     roots[0] = nearest
-                    if not exact and MAX_ROOTS >= 2:
+                    if near is not None and MAX_ROOTS >= 2:
                         # the exact model may still have a close pair of roots the nearly
                         # identical ideal model lacks: try Newton from either side first
                         count = 2
@@ -203,7 +247,8 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                     miss = branch(problem, pitch[n], roots[ri], elbow, q)
                     polished = False
                     hold = False
-                    if need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
+                    # (tentative roots come only from a model close to the family)
+                    if near is not None and need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
                         # a tentative root: a branch only if Newton converges on the exact model
                         if (
                             polish(chain_problem, np.nan, q, scratch, scratch4, scratch5)
@@ -219,7 +264,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                             hold = True
                         else:
                             polished = True
-                    elif not exact and not rooted:
+                    elif near is not None and not rooted:
                         copy5(q, trial)
                         if (
                             polish(chain_problem, np.nan, trial, scratch, scratch4, scratch5)
@@ -229,7 +274,7 @@ def family_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop
                             polished = True
                         else:
                             miss = branch(problem, pitch[n], nearest, elbow, q)
-                    if not exact and not polished:
+                    if near is not None and not polished:
                         rg = roll_given
                         if math.isnan(rg) and (
                             mode == MODE_PITCH
