@@ -41,8 +41,8 @@ NOTICE = (
 ENTRY_KERNELS = (
     "lynxplan.arm.ik_kernel:ik_kernel",
     "lynxplan.arm.ik_select:ik_single_kernel",
-    "lynxplan.robots.ik.family_kernel:family_ik_exact",
-    "lynxplan.robots.ik.family_kernel:family_ik_near",
+    "lynxplan.robots.ik.family_kernel:family_ik_closed_form",
+    "lynxplan.robots.ik.family_kernel:family_ik_general",
     "lynxplan.robots.ik.pose_kernel:pose_kernel",
     "lynxplan.robots.ik.pose_block:blocks",
     "lynxplan.planning.rrt_connect:rrt_connect_begin",

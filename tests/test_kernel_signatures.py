@@ -59,7 +59,7 @@ kernels = {
     "verification_rows": certify.verification_rows,
     "ik_kernel": ik_kernel.ik_kernel,
     "ik_single_kernel": ik_select.ik_single_kernel,
-    "family_ik_near": family_kernel.family_ik_near,
+    "family_ik_general": family_kernel.family_ik_general,
     "pose_kernel": pose_kernel.pose_kernel,
     "blocks": pose_block.blocks,
 }
@@ -109,7 +109,7 @@ def test_each_big_kernel_has_one_compiled_signature() -> None:
     repeated = {name: found for name, found in planning.items() if len(found) > 1}
     # Except the flags that are constants by design, so that an arm compiles only its own code:
     # the vectorised full-pose solver's variants (closed form, Newton step) and the roll
-    # search's (a model of the family exactly or only close to it).
+    # search's (without the polish and the search, for the AL5).
     flagged = {
         f"lynxplan.robots.ik.{name}"
         for name in (

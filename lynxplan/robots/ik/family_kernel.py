@@ -54,9 +54,9 @@ __all__ = [
     "MODE_PITCH",
     "MODE_POSE",
     "ROOT_GRID",
-    "family_ik_exact",
+    "family_ik_closed_form",
+    "family_ik_general",
     "family_ik_kernel",
-    "family_ik_near",
 ]
 
 
@@ -95,12 +95,13 @@ def family_ik_kernel(
             [rad]; B = 4 (closed form) or 4 * MAX_ROOTS (root search).
         miss_out: (N, B) output: by how much the closed form missed the reach, [m].
     """
-    kernel = family_ik_exact if prm[F.EXACT] != 0.0 else family_ik_near
+    closed_form_only = prm[F.EXACT] != 0.0 and prm[F.OFF_AXIS] == 0.0
+    kernel = family_ik_closed_form if closed_form_only else family_ik_general
     kernel(prm, placements, axes, goals, slots, miss_out)
 
 
 @numba.njit(cache=True, nogil=True)
-def family_ik_exact(
+def family_ik_closed_form(
     prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,
@@ -108,13 +109,13 @@ def family_ik_exact(
     slots: BranchSlots,
     miss_out: np.ndarray,
 ) -> None:
-    """:func:`family_ik_kernel` for a model of the family exactly (the AL5): the Newton polish
-    and the exact chain's roll equation are not compiled (they never run for it)."""
-    _family_ik(prm, placements, axes, goals, slots, miss_out, None)
+    """:func:`family_ik_kernel` for a model of the family exactly with the tool point on the roll
+    axis (the AL5): neither the roll search nor the Newton polish is compiled (neither runs)."""
+    _family_ik(prm, placements, axes, goals, slots, miss_out, None, None)
 
 
 @numba.njit(cache=True, nogil=True)
-def family_ik_near(
+def family_ik_general(
     prm: np.ndarray,
     placements: np.ndarray,
     axes: np.ndarray,
@@ -122,8 +123,9 @@ def family_ik_near(
     slots: BranchSlots,
     miss_out: np.ndarray,
 ) -> None:
-    """:func:`family_ik_kernel` for a model only close to the family (the SO-101)."""
-    _family_ik(prm, placements, axes, goals, slots, miss_out, True)
+    """:func:`family_ik_kernel` for any other model (the SO-101: close to the family, the tool
+    off the roll axis)."""
+    _family_ik(prm, placements, axes, goals, slots, miss_out, True, True)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -134,11 +136,14 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
     goals: KernelTargets,
     slots: BranchSlots,
     miss_out: np.ndarray,
-    near: bool | None,
+    polish_code: bool | None,
+    search_code: bool | None,
 ) -> None:
-    """:func:`family_ik_kernel`'s work. ``near``: None for a model of the family exactly, else
-    True (a constant: numba prunes the ``near is not None`` branches, the polish and the exact
-    roll equation, when it compiles the exact model's version)."""
+    """:func:`family_ik_kernel`'s work. ``polish_code`` and ``search_code``: None where the
+    model never needs the Newton polish (a model of the family exactly) or the roll search (the
+    tool point on the roll axis), else True; constants: numba prunes the ``is not None``
+    branches of a None when it compiles, so their code is not compiled (the branches also test
+    the model at run time)."""
     targets, mode, pitch, roll, reference = goals
     q_out, valid, within, position_error, orientation_error = slots
     nb = q_out.shape[1]
@@ -161,6 +166,7 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
     scratch5 = np.empty((6, 5))
     grid_x, grid_f = np.empty(GRID_SIZE), np.empty(GRID_SIZE)
     nearest = 0.0
+    exact = prm[F.EXACT] != 0.0
     off_axis = prm[F.OFF_AXIS] != 0.0
     for n in range(targets.shape[0]):
         target = targets[n]
@@ -183,7 +189,7 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
                 g[i, 3] = target[i, 2]
         roll_given = roll[n]
         need_roots = off_axis and math.isnan(roll_given) and mode != MODE_PITCH
-        if need_roots:
+        if search_code is not None and need_roots:
             prepare_roll_terms(prm, target, g)
         theta_fixed = sig5 * (ref[4] if math.isnan(roll_given) else roll_given)
         for b in range(nb):
@@ -200,10 +206,10 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
             count = 1
             roots[0] = theta_fixed
             rooted = True
-            if need_roots:
+            if search_code is not None and need_roots:
                 m = sample_roll_grid(problem, lo5, hi5, grid_x, grid_f)
                 count = roll_candidates(problem, grid_x, grid_f, m, roots)
-                if near is not None:
+                if polish_code is not None and not exact:
                     count = exact_candidates(
                         problem,
                         (
@@ -236,7 +242,7 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
                     count, rooted = 1, False
                     nearest = nearest_roll(problem, grid_x, grid_f, m)
                     roots[0] = nearest
-                    if near is not None and MAX_ROOTS >= 2:
+                    if polish_code is not None and not exact and MAX_ROOTS >= 2:
                         # the exact model may still have a close pair of roots the nearly
                         # identical ideal model lacks: try Newton from either side first
                         count = 2
@@ -248,7 +254,12 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
                     polished = False
                     hold = False
                     # (tentative roots come only from a model close to the family)
-                    if near is not None and need_roots and rooted and roots[MAX_ROOTS + ri] == 1.0:
+                    if (
+                        polish_code is not None
+                        and need_roots
+                        and rooted
+                        and roots[MAX_ROOTS + ri] == 1.0
+                    ):
                         # a tentative root: a branch only if Newton converges on the exact model
                         if (
                             polish(chain_problem, np.nan, q, scratch, scratch4, scratch5)
@@ -264,7 +275,7 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
                             hold = True
                         else:
                             polished = True
-                    elif near is not None and not rooted:
+                    elif polish_code is not None and not exact and not rooted:
                         copy5(q, trial)
                         if (
                             polish(chain_problem, np.nan, trial, scratch, scratch4, scratch5)
@@ -274,7 +285,7 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
                             polished = True
                         else:
                             miss = branch(problem, pitch[n], nearest, elbow, q)
-                    if near is not None and not polished:
+                    if polish_code is not None and not exact and not polished:
                         rg = roll_given
                         if math.isnan(rg) and (
                             mode == MODE_PITCH
