@@ -1,9 +1,9 @@
 """Shared fixtures: models are loaded once per session.
 
 On a cold numba cache (a clean clone: CI), the kernels are compiled before the tests run, by
-``lynxplan compile``'s own workloads: under ``pytest -n`` (the README's test command) in two
-processes at once, each on a core, while the test session waits; otherwise in one background
-process on the second core while the first tests run. Either way the tests load the kernels
+``lynxplan compile``: under ``pytest -n`` (the README's test command) with two jobs, while the
+test session waits; otherwise in one background process on the second core while the first
+tests run. Either way the tests load the kernels
 from numba's cache instead of compiling them each in its own process, the same kernel in two
 workers at once (measured on the 2-core machine: five Dask tests took 2-4 min each, compiling
 what the other worker was compiling too). It changes no result (the same kernels, the same
@@ -38,26 +38,14 @@ os.environ["PYTHONPATH"] = os.pathsep.join(filter(None, [str(REPO), os.environ.g
 settings.register_profile("lynxplan", derandomize=True, deadline=None)
 settings.load_profile("lynxplan")
 
-#: ``lynxplan compile`` stages compiled in the background on a cold cache (a run without ``-n``),
-#: in this order (the SO-101's IK is first needed by the benchmark-suite and fan-out tests, the
-#: planner next).
-PRECOMPILE = ("IK (SO-101)", "plan (AL5)", "plan (SO-101)")
-#: Under ``pytest -n``: the SO-101's IK (about half of all the compiling) in one process, every
-#: other stage in the other.
-FIRST = ("IK (SO-101)",)
-_PRECOMPILE_CODE = (
-    "import sys\n"
-    "from lynxplan.commands.compile import STAGES\n"
-    "stages = dict(STAGES)\n"
-    f"for name in sys.argv[1:] or [n for n in stages if n not in {set(FIRST)!r}]:\n"
-    "    stages[name]()\n"
-)
+_CLI = "import sys; from lynxplan.cli import main; sys.exit(main())"
 _background: list[subprocess.Popen[bytes]] = []
 
 
-def _compile(*stages: str) -> subprocess.Popen[bytes]:
+def _compile(jobs: int) -> subprocess.Popen[bytes]:
+    """``lynxplan compile --jobs JOBS`` in a process of its own (no output)."""
     return subprocess.Popen(
-        [sys.executable, "-c", _PRECOMPILE_CODE, *stages],
+        [sys.executable, "-c", _CLI, "compile", "--jobs", str(jobs)],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
         start_new_session=True,
@@ -92,13 +80,12 @@ def pytest_sessionstart(session: pytest.Session) -> None:
     if not _jit.cold_kernels():
         return
     if not getattr(session.config.option, "numprocesses", None):
-        _background.append(_compile(*PRECOMPILE))
+        _background.append(_compile(1))
         return
     began = time.perf_counter()
-    processes = [_compile(*FIRST), _compile()]
-    codes = [process.wait() for process in processes]
+    code = _compile(2).wait()
     print(f"\nlynxplan: compiled the numba kernels first ({time.perf_counter() - began:.0f} s, "
-          f"two processes; exit codes {codes})", flush=True)  # fmt: skip
+          f"`lynxplan compile --jobs 2`: exit code {code})", flush=True)  # fmt: skip
 
 
 def pytest_sessionfinish(session: pytest.Session, exitstatus: int) -> None:
