@@ -12,6 +12,7 @@ in one flat array at constant distances, so LLVM needs no aliasing checks.
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from typing import NamedTuple
 
 import numba
@@ -37,10 +38,12 @@ Branches = tuple[Floats, Floats, Floats, Floats, Floats, Floats]
 # inlining (``inline="always"``) of their ~40 call sites would multiply the compile time by 5.
 # (Their Python functions: ``py_func``, or the functions themselves under numba's debugging
 # switch NUMBA_DISABLE_JIT, where a jitted function is the Python function.)
-sincos = numba.njit(nogil=True, fastmath=FAST)(
+sincos: Callable[[float], tuple[float, float]] = numba.njit(nogil=True, fastmath=FAST)(
     getattr(_fastmath.sincos, "py_func", _fastmath.sincos)
 )
-atan2 = numba.njit(nogil=True, fastmath=FAST)(getattr(_fastmath.atan2, "py_func", _fastmath.atan2))
+atan2: Callable[[float, float], float] = numba.njit(nogil=True, fastmath=FAST)(
+    getattr(_fastmath.atan2, "py_func", _fastmath.atan2)
+)
 #: Poses per block (a constant width: the scratch rows never alias).
 BLOCK = 32
 #: The candidate loops run on a multiple of this many lanes (AVX-512: 8 doubles).
