@@ -21,7 +21,7 @@ from concurrent.futures import ProcessPoolExecutor, as_completed
 from typing import Any
 
 from lynxplan import _jit, guards
-from lynxplan.exceptions import InputError
+from lynxplan.commands._output import parse_finite
 
 _WALL = {"name": "wall", "type": "box", "centre": [0.0, 0.25, 0.04], "size": [0.12, 0.12, 0.26]}
 _TABLE = {"name": "table", "type": "box", "centre": [0.0, 0.1, -0.105], "size": [0.9, 0.7, 0.03]}
@@ -191,11 +191,7 @@ def register(subparsers: Any) -> None:
 def _jobs(text: str | None) -> int:
     if text is None:
         return max(1, min(os.cpu_count() or 1, len(HEAVY)))
-    try:
-        value = float(text)
-    except ValueError:
-        raise InputError(f"compile: --jobs: {text!r} is not a number") from None
-    return guards.count("--jobs", value, minimum=1, limit=64)
+    return guards.count("--jobs", parse_finite(text, "--jobs"), minimum=1, limit=64)
 
 
 def handle(args: argparse.Namespace) -> int:

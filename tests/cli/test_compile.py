@@ -75,6 +75,19 @@ def test_compile_is_a_command() -> None:
     assert "numba" in done.stdout
 
 
+@pytest.mark.parametrize(
+    ("jobs", "said"),
+    [("0", "must be an integer >= 1"), ("x", "is not a number"), ("inf", "not a finite"),
+     ("1.5", "must be an integer"), ("65", "must be an integer <= 64")],
+)  # fmt: skip
+def test_compile_refuses_a_bad_job_count_before_compiling(jobs: str, said: str) -> None:
+    done = subprocess.run([LYNXPLAN, "compile", "--jobs", jobs], capture_output=True,
+                          text=True, timeout=60, check=False)  # fmt: skip
+    assert done.returncode == 2
+    assert done.stdout == ""
+    assert done.stderr.count("\n") == 1 and "--jobs" in done.stderr and said in done.stderr
+
+
 def test_cold_kernels_reads_the_cache_index_of_each_kernel(tmp_path: Path) -> None:
     """Against an empty cache every big kernel is cold (numba's own cache dir for them)."""
     script = "from lynxplan import _jit; print(len(_jit.cold_kernels()), _jit.cache_folder())"
