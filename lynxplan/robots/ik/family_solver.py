@@ -15,6 +15,7 @@ from lynxplan.constants import NEAR_AXIS_MARGIN, REACH_TOLERANCE
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
+from lynxplan.robots.ik.elbow_labels import orient_elbows
 from lynxplan.robots.ik.pose_block import pose_block_kernel
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
 from lynxplan.robots.selection import assemble_result
@@ -85,7 +86,7 @@ def solve_poses(
         _kernel(kinematics, sub, ref, part)
         reachable[rest], distance[rest] = _general(kinematics, sub, part)
         out.put(rest, pack_rolls(part, slots // 4))
-    return _batch(out, reachable, distance, slots)
+    return _batch(kinematics, out, reachable, distance, slots)
 
 
 def solve_al5(kinematics: Kinematics, target: Target, reference: np.ndarray) -> RobotIkBatch:
@@ -101,7 +102,7 @@ def solve_al5(kinematics: Kinematics, target: Target, reference: np.ndarray) -> 
         _kernel(kinematics, sub, ref, part)
         out.put(rest, part)
     reachable, distance = _general(kinematics, target, out)
-    return _batch(out, reachable, distance, slots)
+    return _batch(kinematics, out, reachable, distance, slots)
 
 
 def solve_roll_search(
@@ -113,12 +114,19 @@ def solve_roll_search(
     out = BranchSlots.empty(target.poses.shape[0], slots)
     _kernel(kinematics, target, reference, out)
     reachable, distance = _general(kinematics, target, out)
-    return _batch(out, reachable, distance, slots)
+    return _batch(kinematics, out, reachable, distance, slots)
 
 
 def _batch(
-    out: BranchSlots, reachable: np.ndarray, distance: np.ndarray, slots: int
+    kinematics: Kinematics,
+    out: BranchSlots,
+    reachable: np.ndarray,
+    distance: np.ndarray,
+    slots: int,
 ) -> RobotIkBatch:
+    """The batch result, each branch in the slot of its elbow (``elbow_labels``)."""
+    assert kinematics.family is not None
+    orient_elbows(kinematics.family.packed, out, np.arange(out.valid.shape[0]))
     q, valid, within, perr, oerr = out
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)

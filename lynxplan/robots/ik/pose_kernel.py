@@ -40,6 +40,7 @@ from lynxplan.constants import (
 )
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
+from lynxplan.robots.ik.elbow_labels import orient_table
 from lynxplan.robots.ik.family_geometry import MODE_POSE, best_roll, branch, pitch_sum, wrap, yaw
 from lynxplan.robots.ik.family_polish import (
     is_duplicate,
@@ -347,6 +348,7 @@ def pose_one(
     solved = solve_target(prm, placements, axes, target, ref, out, new_pose_scratch())
     if not solved:
         return 0
+    orient_table(prm, out, VALID)
     k = 0
     for b in range(slots):
         if out[b, VALID] != 0.0:
