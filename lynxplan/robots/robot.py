@@ -2,9 +2,8 @@
 
 IK picks its solver from the geometry: the closed form (with a roll root search for an off-axis
 tool where the orientation does not give the roll: approach targets, poses out of reach) when
-the chain is yaw-pitch-pitch-pitch-roll, the numerical solver otherwise. The AL5
-hands poses and approach targets to the existing :class:`lynxplan.arm.model.Arm` kernels, so its
-numbers are those of ``lynxplan.arm``.
+the chain is yaw-pitch-pitch-pitch-roll (the AL5, SO-100, SO-101), the numerical solver
+otherwise.
 
 Targets: a full pose (4x4; for a 5-joint arm solved in the least-squares sense: the position
 exactly, the approach axis projected into the arm plane, the roll nearest), a position plus an
@@ -114,14 +113,7 @@ class Robot:
         self.family: FamilyParameters | None = family
         self.family_reason = reason
         self._zero_reference = np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
-        self._arm: Any = None
-        if builtin is not None and builtin.name == "al5":
-            from lynxplan.arm.model import load_arm
-
-            self._arm = load_arm()
-        self.kinematics = Kinematics(
-            self.chain, family, self.limits.lower, self.limits.upper, self._arm
-        )
+        self.kinematics = Kinematics(self.chain, family, self.limits.lower, self.limits.upper)
 
     # -- description ------------------------------------------------------------------------
     @property
@@ -185,13 +177,8 @@ class Robot:
     def fk(self, q: Any) -> np.ndarray:
         """Tool pose. q: shape (n,) or (N, n) in [rad] -> (4, 4) or (N, 4, 4), in [m]."""
         configs = self._configurations(q)
-        if self._arm is not None:
-            out = np.asarray(self._arm.fk(configs))
-        else:
-            out = np.empty((configs.shape[0], 4, 4))
-            _chain.chain_fk_batch(
-                self.chain.placements, self.chain.axes, kernel_input(configs), out
-            )
+        out = np.empty((configs.shape[0], 4, 4))
+        _chain.chain_fk_batch(self.chain.placements, self.chain.axes, kernel_input(configs), out)
         return out[0] if np.ndim(q) == 1 else out
 
     def jacobian(self, q: Any) -> np.ndarray:

@@ -28,7 +28,7 @@ def test_route_names_the_solver_of_each_row_of_the_table() -> None:
         (so101, make_target(poses[:3], None, None, None, None), dispatch.SCALAR),
         (so101, make_target(None, poses[:, :3, 3], approach, None, None), dispatch.ROLL_SEARCH),
         (so101, make_target(None, poses[:, :3, 3], None, np.zeros(32), None), dispatch.ROLL_SEARCH),
-        (al5, make_target(poses, None, None, None, None), dispatch.AL5),
+        (al5, make_target(poses, None, None, None, None), dispatch.BLOCK),
         (al5, make_target(None, poses[:, :3, 3], None, np.zeros(32), None), dispatch.ROLL_SEARCH),
     ]
     for robot, target, expected in cases:

@@ -57,6 +57,8 @@ class FlipRows(NamedTuple):
 
     geometry: int = 0
     """12 rows: where ``flip_branches`` finds the angles."""
+    wrist_x: int = 9
+    """The shoulder-to-wrist vector's outward component (a geometry row) [m]."""
     candidate: int = 12
     """1/0: the flip is a candidate."""
     fallback: int = 13

@@ -8,7 +8,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Any
 
 import numpy as np
 
@@ -25,15 +24,12 @@ class Kinematics:
         family: The yaw-pitch-pitch-pitch-roll parameters, or None (then IK is numerical).
         lower: Lower joint limits, shape (n,), in [rad] (read-only).
         upper: Upper joint limits, shape (n,), in [rad] (read-only).
-        arm: The AL5 only: the :class:`lynxplan.arm.model.Arm` whose kernels solve its full
-            poses and approach targets (None for every other arm).
     """
 
     chain: Chain
     family: FamilyParameters | None
     lower: np.ndarray
     upper: np.ndarray
-    arm: Any = None
 
     @property
     def nq(self) -> int:
@@ -50,6 +46,4 @@ class Kinematics:
             name += " + roll root search (off-axis tool; reachable poses: roll from orientation)"
         if not self.family.exact:
             name += f" + Newton polish (model off the family by {self.family.deviation:.2g} rad)"
-        if self.arm is not None:
-            name += "; poses and approach targets by lynxplan.arm (AL5 kernels)"
         return name

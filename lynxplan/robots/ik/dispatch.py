@@ -8,8 +8,6 @@ no family (any chain)  pose or approach         any         ``numerical``: Leven
 family, one pose       full pose, roll free     1           ``scalar``: ``solve_pose_one``
 (``Robot.ik``)                                              (closed form, one kernel call);
                                                             a pose it leaves: the rows below
-AL5                    full pose or approach    any         ``al5``: ``solve_al5`` (the kernels
-                                                            of ``lynxplan.arm``)
 family                 full pose, roll free     >= 32       ``block``: ``solve_poses`` by the
                                                             vectorised closed form
                                                             (``pose_block``)
@@ -20,7 +18,7 @@ family                 approach, pitch, or a    any         ``roll search``:
                                                             (``family_kernel``)
 =====================  =======================  ==========  ===================================
 
-Within ``solve_poses`` and ``solve_al5`` the poses the closed form leaves (out of reach,
+Within ``solve_poses`` the poses the closed form leaves (out of reach,
 degenerate, a given roll) go to the roll search; after the roll search a model only close to
 the family (SO-101) gets the near-axis rescue (``rescue_near_axis``: the numerical solver
 started from the branches), where no exact branch was found. Solver functions are in
@@ -39,13 +37,13 @@ import numpy as np
 
 from lynxplan.robots.ik.description import Kinematics
 from lynxplan.robots.results import RobotIkBatch, RobotIkResult
-from lynxplan.robots.targets import KIND_PITCH, KIND_POSE, Target
+from lynxplan.robots.targets import KIND_POSE, Target
 
 #: Full-pose batches of this many poses on are solved by the vectorised closed form (one block
 #: of ``block_layout.BLOCK`` poses: a test checks they agree).
 BLOCK_FROM = 32
 
-NUMERICAL, SCALAR, BLOCK, AL5, ROLL_SEARCH = "numerical", "scalar", "block", "al5", "roll search"
+NUMERICAL, SCALAR, BLOCK, ROLL_SEARCH = "numerical", "scalar", "block", "roll search"
 
 
 @functools.cache
@@ -65,8 +63,6 @@ def route(kinematics: Kinematics, target: Target) -> str:
     """Name of the solver :func:`solve` runs for these targets (the table above)."""
     if kinematics.family is None:
         return NUMERICAL
-    if kinematics.arm is not None and target.kind != KIND_PITCH:
-        return AL5
     if target.kind == KIND_POSE:
         return BLOCK if target.poses.shape[0] >= BLOCK_FROM else SCALAR
     return ROLL_SEARCH
@@ -78,8 +74,6 @@ def solve(kinematics: Kinematics, target: Target, reference: np.ndarray) -> Robo
     batch: RobotIkBatch
     if chosen == NUMERICAL:
         batch = _solver("numerical_solver").solve_numerical(kinematics, target, reference)
-    elif chosen == AL5:
-        batch = _solver("family_solver").solve_al5(kinematics, target, reference)
     elif chosen == ROLL_SEARCH:
         batch = _solver("family_solver").solve_roll_search(kinematics, target, reference)
     else:

@@ -17,6 +17,7 @@ import math
 import numba
 import numpy as np
 
+from lynxplan._fastmath import sincos
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.results import BranchSlots
 
@@ -45,8 +46,8 @@ def elbow_up(prm: np.ndarray, shape: TwoLink, q: np.ndarray) -> bool:
     """
     la, lb, b2, b3 = shape
     psi2, psi3 = prm[F.SIGMA + 1] * q[1], prm[F.SIGMA + 2] * q[2]
-    wrist_x = la * math.cos(psi2 + b2) + lb * math.cos(psi2 + psi3 + b3)
-    return (math.sin(psi3 - b2 + b3) < 0.0) != (wrist_x < 0.0)
+    wrist_x = la * sincos(psi2 + b2)[1] + lb * sincos(psi2 + psi3 + b3)[1]
+    return (sincos(psi3 - b2 + b3)[0] < 0.0) != (wrist_x < 0.0)
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -57,6 +58,8 @@ def pair_swapped(
     branches the wrong way round: every valid one is in the other elbow's slot."""
     if not (v0 or v1):
         return False
+    if v0 and v1 and q0[4] == q1[4]:  # one roll, one wrist point: one question
+        return not elbow_up(prm, shape, q0)
     wrong0 = (not elbow_up(prm, shape, q0)) if v0 else True
     wrong1 = elbow_up(prm, shape, q1) if v1 else True
     return wrong0 and wrong1
@@ -89,12 +92,12 @@ def orient_elbows(prm: np.ndarray, slots: BranchSlots, rows: np.ndarray) -> None
 
 
 @numba.njit(cache=True, nogil=True)
-def orient_table(prm: np.ndarray, table: np.ndarray, valid_column: int) -> None:
+def orient_table(prm: np.ndarray, table: np.ndarray, valid: np.ndarray) -> None:
     """:func:`orient_elbows` of one target's slot table (B, columns): q in columns 0-4, 1/0 in
-    ``valid_column``; swapped pairs swap whole rows."""
+    ``valid`` (B,) (a column of the table); swapped pairs swap whole rows."""
     shape = two_link_shape(prm)
     for b in range(0, table.shape[0], 2):
-        v0, v1 = table[b, valid_column] != 0.0, table[b + 1, valid_column] != 0.0
+        v0, v1 = valid[b] != 0.0, valid[b + 1] != 0.0
         if pair_swapped(prm, shape, table[b, :5], v0, table[b + 1, :5], v1):
             for j in range(table.shape[1]):
                 table[b, j], table[b + 1, j] = table[b + 1, j], table[b, j]

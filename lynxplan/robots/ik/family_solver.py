@@ -1,5 +1,5 @@
 """Python side of the yaw-pitch-pitch-pitch-roll solver: kernel calls, the near-axis rescue,
-the single-pose path, results (the AL5 delegation: ``al5_bridge``). Every function takes the
+the single-pose path, results. Every function takes the
 arm's plain :class:`~lynxplan.robots.ik.description.Kinematics`."""
 
 from __future__ import annotations
@@ -14,7 +14,6 @@ from lynxplan._arrays import kernel_input
 from lynxplan.constants import NEAR_AXIS_MARGIN, REACH_TOLERANCE
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
-from lynxplan.robots.ik.al5_bridge import al5_fill, solve_al5_pose_one
 from lynxplan.robots.ik.elbow_labels import orient_elbows
 from lynxplan.robots.ik.pose_block import pose_block_kernel
 from lynxplan.robots.results import BranchSlots, RobotIkBatch, RobotIkResult
@@ -85,24 +84,9 @@ def solve_poses(
         part = BranchSlots.empty(sub.poses.shape[0], 4 if slots == 4 else 4 * fk_.MAX_ROOTS)
         _kernel(kinematics, sub, ref, part)
         reachable[rest], distance[rest] = _general(kinematics, sub, part)
+        _orient(kinematics, part)
         out.put(rest, pack_rolls(part, slots // 4))
-    return _batch(kinematics, out, reachable, distance, slots)
-
-
-def solve_al5(kinematics: Kinematics, target: Target, reference: np.ndarray) -> RobotIkBatch:
-    """The AL5's full poses and approach targets: the kernels of ``lynxplan.arm``
-    (``al5_bridge``); the targets they leave go through the roll search."""
-    slots = slot_count(kinematics, target)
-    out = BranchSlots.empty(target.poses.shape[0], slots)
-    out.clear()
-    rest = ~al5_fill(kinematics, target, reference, out)
-    if rest.any():
-        sub, ref = _rows(target, reference, rest)
-        part = out.rows(rest)
-        _kernel(kinematics, sub, ref, part)
-        out.put(rest, part)
-    reachable, distance = _general(kinematics, target, out)
-    return _batch(kinematics, out, reachable, distance, slots)
+    return _batch(out, reachable, distance, slots)
 
 
 def solve_roll_search(
@@ -114,19 +98,20 @@ def solve_roll_search(
     out = BranchSlots.empty(target.poses.shape[0], slots)
     _kernel(kinematics, target, reference, out)
     reachable, distance = _general(kinematics, target, out)
-    return _batch(kinematics, out, reachable, distance, slots)
+    _orient(kinematics, out)
+    return _batch(out, reachable, distance, slots)
+
+
+def _orient(kinematics: Kinematics, out: BranchSlots) -> None:
+    """Each branch the roll search and the rescue found, in the slot of its elbow (the closed
+    forms place theirs: ``elbow_labels``)."""
+    assert kinematics.family is not None
+    orient_elbows(kinematics.family.packed, out, np.arange(out.valid.shape[0]))
 
 
 def _batch(
-    kinematics: Kinematics,
-    out: BranchSlots,
-    reachable: np.ndarray,
-    distance: np.ndarray,
-    slots: int,
+    out: BranchSlots, reachable: np.ndarray, distance: np.ndarray, slots: int
 ) -> RobotIkBatch:
-    """The batch result, each branch in the slot of its elbow (``elbow_labels``)."""
-    assert kinematics.family is not None
-    orient_elbows(kinematics.family.packed, out, np.arange(out.valid.shape[0]))
     q, valid, within, perr, oerr = out
     for array in (q, valid, within, perr, oerr, reachable, distance):
         array.setflags(write=False)
@@ -280,11 +265,9 @@ def solve_pose_one(
     kinematics: Kinematics, pose: Any, reference: np.ndarray
 ) -> RobotIkResult | None:
     """One full pose (4, 4) with the roll free, the lean way (one kernel call, no batch
-    arrays; the AL5 through ``Arm.ik``): the result, or None where the pose needs the general
+    arrays): the result, or None where the pose needs the general
     path (not finite or rigid, out of reach, degenerate). ``reference`` (n,) [rad]."""
     pose = np.ascontiguousarray(pose, dtype=float)
-    if kinematics.arm is not None:
-        return solve_al5_pose_one(kinematics, pose, reference)
     family = kinematics.family
     assert family is not None
     slots = 4 if family.tool_on_roll_axis else 4 * POSE_ROLLS

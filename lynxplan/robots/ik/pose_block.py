@@ -240,8 +240,11 @@ def blocks(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
             base = POSE.flips + (0 if cand0 else FLIP.rows)
             side = s[base + FLIP.side, i]
             slot = int(side) * per_side + (0 if cand0 or per_side <= 2 else 2)
+            # the elbow-up slot takes the elbow above the shoulder-wrist line: the two-link's
+            # elbow 0 where the wrist lies ahead of the shoulder (``elbow_labels``)
+            behind = 1 if s[base + FLIP.wrist_x, i] < 0.0 else 0
             lane_of[4 * i], lane_of[4 * i + 1] = i, BLOCK + i
-            slot_of[i], slot_of[BLOCK + i] = slot, slot + 1
+            slot_of[i], slot_of[BLOCK + i] = slot + behind, slot + 1 - behind
         for i in range(m if second_flips else 0):  # the second candidate flips: gathered
             fall = s[POSE.fallback, i] != 0.0
             if (
@@ -273,7 +276,10 @@ def blocks(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                         c[CANDIDATE.fold, mc] = s[base + FLIP.fold, i]
                         mc += 1
                     lane_of[4 * i + owned[i]] = lane
-                    slot_of[lane] = side * per_side + (flip * 2 if per_side > 2 else 0) + elbow
+                    behind = 1 if s[base + FLIP.wrist_x, i] < 0.0 else 0
+                    slot_of[lane] = (
+                        side * per_side + (flip * 2 if per_side > 2 else 0) + (elbow ^ behind)
+                    )
                     owned[i] += 1
         for lane in range(2 * BLOCK, mc):
             for k in range(5):

@@ -300,6 +300,7 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                 out[b, POSITION_ERROR] = err
                 out[b, ORIENTATION_ERROR] = angle
                 solved = True
+    orient_table(prm, out, out[:, VALID])  # each branch in its elbow's slot
     return solved
 
 
@@ -348,7 +349,6 @@ def pose_one(
     solved = solve_target(prm, placements, axes, target, ref, out, new_pose_scratch())
     if not solved:
         return 0
-    orient_table(prm, out, VALID)
     k = 0
     for b in range(slots):
         if out[b, VALID] != 0.0:
