@@ -9,7 +9,6 @@ import subprocess
 import sys
 
 import numba
-import numpy as np
 
 from lynxplan._jit import compile_before_timing
 
@@ -61,38 +60,87 @@ def test_a_constant_flag_prunes_the_other_branch_before_it_is_compiled() -> None
     assert on_axis.signatures
 
 
-def test_lynxplan_runs_under_numbas_debugging_switch() -> None:
-    """With NUMBA_DISABLE_JIT=1 (numba's switch for debugging jitted code as Python) the
-    kernels run as Python and answer as compiled, to rounding: the first IK of an SO-101 pose,
-    roll free, position and approach, and the same through the command line."""
-    code = (
-        "import json, numpy as np, lynxplan; r = lynxplan.load_robot('so101');"
-        " q = np.array([0.3, -0.4, 0.9, 0.6, -1.2]); T = r.fk(q);"
-        " a = r.ik(T); b = r.ik(position=T[:3, 3], approach=T[:3, 2]);"
-        " print(json.dumps([a.q.tolist(), b.q.tolist()]))"
-    )
-    env = {**os.environ, "NUMBA_DISABLE_JIT": "1"}
-    done = subprocess.run(
-        [sys.executable, "-c", code], capture_output=True, text=True, env=env, check=False
-    )
-    assert done.returncode == 0, done.stderr[-2000:]
-    interpreted = json.loads(done.stdout)
-    import lynxplan
+#: Answers of the IK solvers to random targets of each kind, as JSON (floats written exactly).
+ANSWERS = """
+import json, sys
+import numpy as np
+from lynxplan import load_robot
+from lynxplan.arm import load_arm
 
-    robot = lynxplan.load_robot("so101")
-    pose = robot.fk(np.array([0.3, -0.4, 0.9, 0.6, -1.2]))
-    compiled = [
-        robot.ik(pose).q,
-        robot.ik(position=pose[:3, 3], approach=pose[:3, 2]).q,
-    ]
-    for got, want in zip(interpreted, compiled, strict=True):
-        np.testing.assert_allclose(got, want, rtol=0.0, atol=1e-12)
+def answers(name, count):
+    robot = load_robot(name)
+    rng = np.random.default_rng(11)
+    poses = robot.fk(robot.random_configurations(count, seed=21))
+    out = []
+    for k, pose in enumerate(poses):
+        moved = pose.copy()
+        moved[:3, 3] += rng.normal(0.0, 0.05, 3)  # mostly off the reachable orientations
+        targets = [dict(pose=pose), dict(position=pose[:3, 3], approach=pose[:3, 2])]
+        if robot.family is not None:
+            targets += [dict(position=pose[:3, 3], pitch=float(rng.uniform(-1, 1))),
+                        dict(pose=moved)]
+        for target in targets:
+            result = robot.ik(**target)
+            out.append([[s.q.tolist() for s in result.solutions], [s.branch for s in
+                        result.solutions], result.selected, result.distance])
+    return out
+
+def arm_answers(count):
+    arm = load_arm()
+    rng = np.random.default_rng(3)
+    poses = arm.fk(rng.uniform(arm.limits.lower, arm.limits.upper, (count, 5)))
+    out = [poses.tolist(), np.asarray(arm.ik_batch(poses).q).tolist()]
+    for pose in poses:
+        for select in ("nearest", "report"):
+            result = arm.ik(pose, select=select)
+            out.append([[s.q.tolist() for s in result.solutions], result.selected])
+    return out
+
+counts = json.loads(sys.argv[1])
+print(json.dumps({name: answers(name, n) for name, n in counts.items()} | {"arm": arm_answers(20)}))
+"""
+
+
+def test_the_kernels_answer_the_same_bits_interpreted() -> None:
+    """Run as Python (numba's switch NUMBA_DISABLE_JIT=1, the command line's single-target
+    ``ik``) the kernels give the compiled answers to the last bit: every IK solver (closed form,
+    roll search, near-axis rescue, numerical, the AL5's own kernels) on random targets."""
+    counts = json.dumps({"al5": 12, "so100": 8, "so101": 12, "ur5": 6})
+    runs = []
+    for switch in ("1", "0"):
+        env = {**os.environ, "NUMBA_DISABLE_JIT": switch}
+        done = subprocess.run(
+            [sys.executable, "-c", ANSWERS, counts],
+            capture_output=True,
+            text=True,
+            env=env,
+            timeout=600,
+            check=False,
+        )
+        assert done.returncode == 0, done.stderr[-2000:]
+        runs.append(json.loads(done.stdout))
+    interpreted, compiled = runs
+    for name in compiled:
+        assert interpreted[name] == compiled[name], name
+
+
+def test_one_ik_target_from_the_command_line_compiles_nothing(tmp_path) -> None:
+    """``lynxplan ik`` of one target runs the kernels as Python: on an empty numba cache it
+    writes no cache file and answers as the compiled library does."""
     cli = "import sys; from lynxplan.cli import main; sys.exit(main())"
     command = [sys.executable, "-c", cli, "ik", "--robot", "so101",
                "--position", "0.2", "0", "0.1", "--approach", "0", "0", "-1", "--json"]  # fmt: skip
+    env = {k: v for k, v in os.environ.items() if k != "NUMBA_DISABLE_JIT"}
+    env["NUMBA_CACHE_DIR"] = str(tmp_path)
     shell = subprocess.run(command, capture_output=True, text=True, env=env, check=False)
     assert shell.returncode == 0, shell.stderr[-2000:]
-    assert json.loads(shell.stdout)["solutions"]
+    assert not list(tmp_path.rglob("*.nb*"))  # nothing compiled
+    import lynxplan
+
+    robot = lynxplan.load_robot("so101")
+    result = robot.ik(position=[0.2, 0.0, 0.1], approach=[0.0, 0.0, -1.0])
+    answered = json.loads(shell.stdout)["solutions"]
+    assert [s["q"] for s in answered] == [s.q.tolist() for s in result.solutions]
 
 
 ANNOUNCE = """

@@ -23,12 +23,11 @@ from lynxplan.constants import (
 )
 
 TWO_PI = 2.0 * math.pi
-#: IEEE-safe fast-math flags: fused multiply-add and division by reciprocal (rounding differs
-#: by an ulp; no assumptions about NaN, infinity or signed zeros, which the kernels rely on).
-_FAST = {"contract", "arcp"}
+# No fast-math flags: the kernels give the same bits compiled and interpreted (numba's
+# NUMBA_DISABLE_JIT, the command line's single-target ik; tests/test_jit.py).
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _dot3(u: np.ndarray, v: np.ndarray) -> float:
     """Dot product of two 3-vectors (numba's ``@`` calls BLAS: slow for 3 elements)."""
     return float(u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
@@ -91,7 +90,7 @@ FOLD_SNAP_K = FOLD_SNAP_TOLERANCE  # elbow cosines this close to +-1 are +-1
 FAR_AWAY_K = FAR_AWAY  # [m]: out of reach before any arithmetic can overflow
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: bool) -> None:
     """Gram-Schmidt from the approach axis, in place: a normalised; unless ``approach_only``,
     n made orthogonal to a and normalised, and o = a x n."""
@@ -111,7 +110,7 @@ def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: 
     o[2] = a[0] * n[1] - a[1] * n[0]
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
     """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside.
 
@@ -128,7 +127,7 @@ def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float,
     return (x if inside else out), inside | snap_hi | snap_lo
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _angle_of_matrix(m: tuple[float, ...]) -> float:
     """Rotation angle of the rotation matrix M (its 9 entries, row-major), in [rad], accurate
     near 0 (atan2 of sine and cosine; the small-angle series by a select, so array loops over
@@ -142,7 +141,7 @@ def _angle_of_matrix(m: tuple[float, ...]) -> float:
     return sine + sine * sine * sine / 6.0 if small else atan2(sine, cosine)
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _angle_between_frames(
     n_t: np.ndarray,
     o_t: np.ndarray,
@@ -179,13 +178,13 @@ _WITHIN = _Q + 20
 _ROWS = _WITHIN + 4
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _max(x: float, y: float) -> float:
     """The larger of x and y, NaN when either is NaN (a select: vectorises)."""
     return x if (x >= y) | math.isnan(x) else y
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _admit(s: np.ndarray, i: int, approach_only: bool) -> tuple[float, ...]:
     """Step 1 for column i: (finite, far, deviation, a (3), n (3)): finite is 0 for a finite
     pose (x * 0 is NaN for NaN and infinity), far its largest coordinate [m] (squares overflow
@@ -216,7 +215,7 @@ def _admit(s: np.ndarray, i: int, approach_only: bool) -> tuple[float, ...]:
     return finite, far, deviation, ax, ay, az, nx * scale, ny * scale, nz * scale
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _branch(
     s: np.ndarray,
     i: int,
@@ -247,7 +246,7 @@ def _branch(
     s[_WITHIN + b, i] = 1.0 if within else 0.0
 
 
-@numba.njit(cache=True, nogil=True, inline="always", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, inline="always")
 def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
     m: int, params: IkParams, s: np.ndarray
 ) -> None:
@@ -365,7 +364,7 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         s[_DEVIATION, i] = deviation if (finite == 0.0) & (far <= FAR_AWAY_K) else 0.0
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", fastmath=_FAST)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def ik_kernel(T: np.ndarray, q_ref: np.ndarray, params: IkParams, out: IkOutputs) -> None:
     """IK of poses T (N, 4, 4) into ``out`` (see :class:`IkBatch`): admit the pose, find the arm
     plane, check the reach, write the four branches, measure the orientation residual.

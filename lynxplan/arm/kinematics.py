@@ -28,12 +28,10 @@ __all__ = [
 _DEFAULT_GEOMETRY = ArmGeometry()
 
 
-_tool_pose = numba.njit(cache=True, nogil=True, inline="always", fastmath={"contract"})(
-    tool_pose_from_sines
-)
+_tool_pose = numba.njit(cache=True, nogil=True, inline="always")(tool_pose_from_sines)
 
 
-@numba.njit(cache=True, nogil=True, fastmath={"contract"})  # FMA: same results to an ulp
+@numba.njit(cache=True, nogil=True)
 def fk_kernel(q: np.ndarray, a2: float, a3: float, d5: float, out: np.ndarray) -> None:
     """Write the tool transforms of the configurations ``q`` (N, 5) into ``out`` (N, 4, 4)."""
     for k in range(q.shape[0]):

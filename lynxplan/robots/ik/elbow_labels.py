@@ -19,6 +19,7 @@ import numpy as np
 
 from lynxplan._fastmath import sincos
 from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.ik.family_geometry import hypot
 from lynxplan.robots.results import BranchSlots
 
 #: The two-link triangle of an arm (``two_link_shape``): the link lengths la, lb [m] and the
@@ -32,7 +33,7 @@ def two_link_shape(prm: np.ndarray) -> TwoLink:
     angles at zero joint angles [rad] (as ``family_geometry.two_link`` builds them)."""
     l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
-    return math.hypot(l20, l21), math.hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30)
+    return hypot(l20, l21), hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30)
 
 
 @numba.njit(cache=True, nogil=True)

@@ -9,7 +9,11 @@ packed parameter vector of ``family.py``.
 
 from __future__ import annotations
 
+import ctypes
+import ctypes.util
 import math
+from collections.abc import Callable
+from typing import cast
 
 import numba
 import numpy as np
@@ -24,6 +28,23 @@ RollProblem = tuple[np.ndarray, np.ndarray, np.ndarray, int, int, float, float]
 #: One target on the exact chain: (prm, placements, axes, target, g, mode, pitch).
 ChainProblem = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray, int, float]
 TWO_PI = 2.0 * math.pi
+
+
+def _libm_hypot() -> Callable[[float, float], float]:
+    """The C library's ``hypot``: what numba's compiled ``math.hypot`` calls (CPython's own
+    ``math.hypot`` rounds differently in the last bit)."""
+    libm = ctypes.CDLL(ctypes.util.find_library("m") or "libm.so.6")
+    function = libm.hypot
+    function.restype = ctypes.c_double
+    function.argtypes = (ctypes.c_double, ctypes.c_double)
+    return cast(Callable[[float, float], float], function)
+
+
+#: sqrt(x^2 + y^2) without overflow, the same bits compiled and interpreted: compiled kernels
+#: call the C library's ``hypot`` for ``math.hypot``; under numba's ``NUMBA_DISABLE_JIT`` (the
+#: command line's single-target ``ik``) the kernels are Python and call it through ctypes.
+_INTERPRETED: bool = getattr(numba.config, "DISABLE_JIT", False)
+hypot: Callable[[float, float], float] = _libm_hypot() if _INTERPRETED else math.hypot
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -57,7 +78,7 @@ def yaw(
         + math.cos(theta) * prm[F.E1 + 2]
         + math.sin(theta) * prm[F.E2 + 2]
     )
-    rho = math.hypot(dp, dh)
+    rho = hypot(dp, dh)
     if rho <= 1e-12 and abs(lat) <= 1e-12:  # on the yaw axis: any yaw; keep the reference
         return phi_ref + side * math.pi, 0.0
     ratio, miss = lat / rho if rho > 0 else math.copysign(1.0, lat), 0.0
@@ -149,7 +170,7 @@ def pitch_sum(
     if mode == MODE_PITCH:
         return pitch - 0.5 * math.pi - prm[F.GAMMA0], 0.0
     ah, ak, out = approach_in_plane(prm, a0, a1, a2, phi)
-    if math.hypot(ah, ak) <= 1e-12:  # approach along the pitch axis: any pitch is as good
+    if hypot(ah, ak) <= 1e-12:  # approach along the pitch axis: any pitch is as good
         return ref_sum, out
     return math.atan2(ak, ah) - prm[F.GAMMA0], out
 
@@ -159,10 +180,10 @@ def two_link(prm: np.ndarray, x: float, y: float, elbow: int) -> tuple[float, fl
     """Canonical shoulder and elbow angles reaching the wrist point (x, y); and the miss [m]."""
     l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
     l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
-    la, lb = math.hypot(l20, l21), math.hypot(l30, l31)
+    la, lb = hypot(l20, l21), hypot(l30, l31)
     b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
     rx, ry = x - prm[F.O2], y - prm[F.O2 + 1]
-    dist = math.hypot(rx, ry)
+    dist = hypot(rx, ry)
     cosd = (dist * dist - la * la - lb * lb) / (2.0 * la * lb)
     miss = 0.0
     if cosd > 1.0:
@@ -207,4 +228,4 @@ def branch(problem: RollProblem, pitch: float, theta: float, elbow: int, out: np
     out[2] = prm[F.SIGMA + 2] * psi3
     out[3] = prm[F.SIGMA + 3] * (big_phi - psi2 - psi3)
     out[4] = prm[F.SIGMA + 4] * theta
-    return math.hypot(miss, lat_miss)
+    return hypot(miss, lat_miss)

@@ -11,7 +11,7 @@ import numpy as np
 
 from lynxplan import _jit
 from lynxplan._arrays import kernel_input
-from lynxplan.constants import NEAR_AXIS_MARGIN, REACH_TOLERANCE
+from lynxplan.constants import BRANCH_DUPLICATE_TOLERANCE, NEAR_AXIS_MARGIN, REACH_TOLERANCE
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.elbow_labels import orient_elbows
@@ -229,7 +229,10 @@ def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -
         found, ok, p_err, o_err, _ = result
         for i in np.flatnonzero(ok):
             taken = q[row][valid[row]]
-            if taken.size and np.abs(taken - found[i]).max(axis=1).min() < 1e-9:
+            if (
+                taken.size
+                and np.abs(taken - found[i]).max(axis=1).min() < BRANCH_DUPLICATE_TOLERANCE
+            ):
                 continue
             free = np.flatnonzero(~valid[row])
             if free.size == 0:

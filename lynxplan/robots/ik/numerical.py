@@ -20,6 +20,7 @@ from lynxplan.constants import (
     NUMERICAL_POSITION_TOLERANCE,
 )
 from lynxplan.robots.chain import chain_fk_jacobian
+from lynxplan.robots.ik.family_polish import lu_factor, lu_solve
 
 MAX_ITERATIONS = 200
 DEFAULT_STARTS = 128
@@ -148,8 +149,8 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
     origins = np.empty((n, 6))
     e, e_new = np.empty(6), np.empty(6)
     q, q_new = np.empty(n), np.empty(n)
-    a = np.empty((n, n))
-    b = np.empty(n)
+    a = np.empty((n + 1, n))  # the normal equations, then their LU factors (``lu_factor``)
+    b, step = np.empty(n), np.empty(n)
     for k in range(targets.shape[0]):
         target = targets[k]
         best_cost = np.inf
@@ -184,7 +185,8 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
                             acc += jac[r, i] * jac[r, j]
                         a[i, j] = acc
                     a[i, i] += lam * (1.0 + a[i, i])
-                step = np.linalg.solve(a, b)
+                lu_factor(a)  # damped normal equations: positive definite, never singular
+                lu_solve(a, b, step)
                 for j in range(n):
                     q_new[j] = min(max(q[j] + step[j], lower[j]), upper[j])
                 chain_fk_jacobian(placements, axes, q_new, pose, jac, work, origins)
@@ -207,11 +209,12 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
                     if lam > 1e8:
                         break
             chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
-            perr = math.sqrt(
-                (pose[0, 3] - target[0, 3]) ** 2
-                + (pose[1, 3] - target[1, 3]) ** 2
-                + (pose[2, 3] - target[2, 3]) ** 2
+            d0, d1, d2 = (
+                pose[0, 3] - target[0, 3],
+                pose[1, 3] - target[1, 3],
+                pose[2, 3] - target[2, 3],
             )
+            perr = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
             oerr = _angle(pose, target, approach_only, approach_axis)
             score = perr + 0.1 * oerr
             if score < best_cost:

@@ -41,7 +41,15 @@ from lynxplan.constants import (
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
 from lynxplan.robots.ik.elbow_labels import orient_table
-from lynxplan.robots.ik.family_geometry import MODE_POSE, best_roll, branch, pitch_sum, wrap, yaw
+from lynxplan.robots.ik.family_geometry import (
+    MODE_POSE,
+    best_roll,
+    branch,
+    hypot,
+    pitch_sum,
+    wrap,
+    yaw,
+)
 from lynxplan.robots.ik.family_polish import (
     is_duplicate,
     lu_factor,
@@ -246,17 +254,17 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
         g[i, 3] = g[i, 0] * prm[F.R] + g[i, 1] * prm[F.R + 1] + g[i, 2] * prm[F.R + 2]
     a_h = g[0, 3] * prm[F.H] + g[1, 3] * prm[F.H + 1] + g[2, 3] * prm[F.H + 2]
     a_p = g[0, 3] * prm[F.P] + g[1, 3] * prm[F.P + 1] + g[2, 3] * prm[F.P + 2]
-    if math.hypot(a_h, a_p) <= AXIAL_APPROACH:
+    if hypot(a_h, a_p) <= AXIAL_APPROACH:
         return False
     d0 = target[0, 3] - prm[F.C1]
     d1 = target[1, 3] - prm[F.C1 + 1]
     d2 = target[2, 3] - prm[F.C1 + 2]
-    rho = math.hypot(
+    rho = hypot(
         d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2],
         d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2],
     )
-    axial = math.hypot(a_h, a_p)
-    reach = math.hypot(prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]) + math.hypot(
+    axial = hypot(a_h, a_p)
+    reach = hypot(prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]) + hypot(
         prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
     )
     solved = False

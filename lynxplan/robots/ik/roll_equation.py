@@ -22,6 +22,7 @@ from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
     RollProblem,
     best_roll,
+    hypot,
     pitch_sum,
     yaw,
 )
@@ -64,7 +65,7 @@ def prepare_roll_terms(prm: np.ndarray, target: np.ndarray, g: np.ndarray) -> No
     d2 = target[2, 3] - prm[F.C1 + 2]
     dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
     dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
-    rho = math.hypot(dp, dh)
+    rho = hypot(dp, dh)
     g[3, 0] = rho
     g[3, 1] = dp / rho if rho > 0.0 else 1.0
     g[3, 2] = dh / rho if rho > 0.0 else 0.0
@@ -173,7 +174,7 @@ def lateral_miss(problem: RollProblem, theta: float) -> float:
     d2 = target[2, 3] - prm[F.C1 + 2]
     dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
     dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
-    rho = math.hypot(dp, dh)
+    rho = hypot(dp, dh)
     if rho <= ROLL_DEGENERATE:
         return yaw(prm, d0, d1, d2, theta, side, phi_ref)[1]
     lat: float = (

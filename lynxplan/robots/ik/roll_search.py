@@ -106,12 +106,11 @@ def sample_roll_grid(
             boundary = b if c0 else a  # on the reachable side
             for j in range(1, BOUNDARY_SAMPLES + 1):
                 if c0:  # clamped -> reachable: from the boundary outwards
-                    x = boundary + (x1 - boundary) * ((j - 1) / BOUNDARY_SAMPLES) ** 2
+                    u = (j - 1) / BOUNDARY_SAMPLES
+                    x = boundary + (x1 - boundary) * (u * u)
                 else:  # reachable -> clamped: towards the boundary
-                    x = (
-                        boundary
-                        - (boundary - x0) * ((BOUNDARY_SAMPLES - j) / BOUNDARY_SAMPLES) ** 2
-                    )
+                    u = (BOUNDARY_SAMPLES - j) / BOUNDARY_SAMPLES
+                    x = boundary - (boundary - x0) * (u * u)
                 if x <= xs[m] or x >= x1:
                     continue
                 m += 1
@@ -355,11 +354,12 @@ def exact_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan
     prm, target, g = problem[0], problem[1], problem[2]
     # the ideal and exact equations differ by up to ~6 deviations times d / rho (a position
     # error of the model turns the yaw by 1 / rho): measured on the SO-101
-    d = math.sqrt(
-        (target[0, 3] - prm[F.C1]) ** 2
-        + (target[1, 3] - prm[F.C1 + 1]) ** 2
-        + (target[2, 3] - prm[F.C1 + 2]) ** 2
+    d0, d1, d2 = (
+        target[0, 3] - prm[F.C1],
+        target[1, 3] - prm[F.C1 + 1],
+        target[2, 3] - prm[F.C1 + 2],
     )
+    d = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     band = EXACT_BAND * prm[F.DEVIATION] * (1.0 + d / max(g[3, 0], 1e-9))
     first = 0
     while first <= m and not abs(fs[first]) < band:
