@@ -62,7 +62,8 @@ _state = {"notices": False, "listening": False, "said": False}
 def compile_before_timing(kernel: Any, args: tuple[Any, ...]) -> float:
     """Make sure ``kernel`` (a numba dispatcher) is compiled for ``args``, without running it;
     returns the seconds it took (0 when it already has a compiled version in this process)."""
-    if kernel.overloads:  # (not .signatures: it hashes every signature, ~20 us for a big one)
+    overloads = getattr(kernel, "overloads", None)  # None: a Python function (interpreted)
+    if overloads is None or overloads:  # (not .signatures: it hashes every one, ~20 us)
         return 0.0
     import numba
 

@@ -235,7 +235,9 @@ class Planner:
         its own kernel outside its time limit.)"""
         # (the entry points called from Python: a kernel loaded from numba's cache registers no
         # overloads for its compiled callees; .signatures: ~20 us each)
-        if cast(Any, shortcut_path).overloads and cast(Any, verification_rows).overloads:
+        # (Python functions, under numba's NUMBA_DISABLE_JIT, have nothing to compile)
+        kernels = (cast(Any, shortcut_path), cast(Any, verification_rows))
+        if all(getattr(kernel, "overloads", True) for kernel in kernels):
             return
         path = np.vstack([q, q])
         lower, upper = self.space.lower, self.space.upper
