@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING, Any
 from lynxplan.exceptions import LynxplanError
 
 if TYPE_CHECKING:
+    from lynxplan._jit import CompileWarning
     from lynxplan.arm.model import Arm, load_arm
     from lynxplan.planning.planner import PlannedTrajectory, plan
     from lynxplan.robots import Robot, load_robot
@@ -18,6 +19,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "Arm",
+    "CompileWarning",
     "LynxplanError",
     "PlannedTrajectory",
     "Robot",
@@ -29,10 +31,23 @@ __all__ = [
 ]
 
 
+#: Lazy public name -> the module that defines it.
+_HOMES = {
+    "load_arm": "lynxplan.arm.model",
+    "Arm": "lynxplan.arm.model",
+    "load_robot": "lynxplan.robots",
+    "Robot": "lynxplan.robots",
+    "plan": "lynxplan.planning.planner",
+    "PlannedTrajectory": "lynxplan.planning.planner",
+    "run_scenario": "lynxplan.scenarios.runner",
+    "CompileWarning": "lynxplan._jit",
+}
+
+
 def __getattr__(name: str) -> Any:
     """Lazy attributes: ``__version__`` (the installed distribution's, read from its metadata:
     pyproject.toml is the one place it is written), ``load_arm``, ``Arm``, ``load_robot``,
-    ``Robot``, ``run_scenario``, ``plan``, ``PlannedTrajectory``."""
+    ``Robot``, ``run_scenario``, ``plan``, ``PlannedTrajectory``, ``CompileWarning``."""
     if name == "__version__":
         from importlib.metadata import PackageNotFoundError, version
 
@@ -40,20 +55,8 @@ def __getattr__(name: str) -> Any:
             return version("lynxplan")
         except PackageNotFoundError:  # a source tree on sys.path, no installed distribution
             return "0+unknown"
-    if name in ("load_arm", "Arm"):
-        from lynxplan.arm import model
+    if name in _HOMES:
+        import importlib
 
-        return getattr(model, name)
-    if name in ("load_robot", "Robot"):
-        from lynxplan import robots
-
-        return getattr(robots, name)
-    if name in ("plan", "PlannedTrajectory"):
-        from lynxplan.planning import planner
-
-        return getattr(planner, name)
-    if name == "run_scenario":
-        from lynxplan.scenarios.runner import run_scenario
-
-        return run_scenario
+        return getattr(importlib.import_module(_HOMES[name]), name)
     raise AttributeError(f"module 'lynxplan' has no attribute {name!r}")

@@ -5,9 +5,11 @@ to the sources. The first use after installation compiles: half a minute for the
 about two minutes for the planner on a small machine.
 
 - :func:`compile_before_timing` compiles a kernel before a clock or a time limit starts.
-- :func:`enable_notices` (the CLI, when stderr is a terminal) and :func:`listen` (called by the
-  modules of the big kernels once numba is imported: the CLI's light commands never import it)
-  print :data:`NOTICE` on stderr once compiling has taken :data:`NOTICE_AFTER` seconds. numba
+- :func:`listen` (called by the modules of the big kernels once numba is imported: the CLI's
+  light commands never import it) says :data:`NOTICE` once compiling has taken
+  :data:`NOTICE_AFTER` seconds: as a :class:`CompileWarning` in a Python program (a notebook, a
+  script: the first plan compiles for minutes, never in silence), on stderr in the CLI when
+  stderr is a terminal (:func:`enable_notices`), not at all after :func:`disable_notices`. numba
   reports a compile only when its cache had no version of the kernel for the argument types:
   the notice never shows on a warm cache.
 - :func:`interpret_one_target` (the CLI's single-target ``ik`` and ``fk``) runs the kernels as
@@ -27,6 +29,7 @@ import os
 import sys
 import threading
 import time
+import warnings
 from collections.abc import Callable
 from typing import Any
 
@@ -56,7 +59,15 @@ ENTRY_KERNELS = (
     "lynxplan.planning.certify:verification_rows",
 )
 
-_state = {"notices": False, "listening": False, "said": False}
+
+class CompileWarning(UserWarning):
+    """numba is compiling lynxplan's kernels for the first time (minutes; once per
+    installation). ``warnings.filterwarnings("ignore", category=lynxplan.CompileWarning)``
+    silences it; ``lynxplan compile`` pays the compile ahead."""
+
+
+#: notices: None (a Python program: warn), True (the CLI on a terminal: print), False (quiet).
+_state: dict[str, bool | None] = {"notices": None, "listening": False, "said": False}
 
 
 def compile_before_timing(kernel: Any, args: tuple[Any, ...]) -> float:
@@ -140,8 +151,8 @@ def cache_folder(kernel: str = ENTRY_KERNELS[0]) -> str:
 
 
 def listen() -> None:
-    """Start watching numba's compiles if :func:`enable_notices` asked for it (idempotent)."""
-    if not _state["notices"] or _state["listening"]:
+    """Start watching numba's compiles unless notices are off (idempotent)."""
+    if _state["notices"] is False or _state["listening"]:
         return
     from numba.core import event
 
@@ -186,7 +197,10 @@ class _Announcer:
 
     def _say(self) -> None:
         self.said = True
-        if not _state["notices"] or _state["said"]:
+        if _state["notices"] is False or _state["said"]:
             return
         _state["said"] = True
-        print(NOTICE, file=sys.stderr, flush=True)
+        if _state["notices"]:
+            print(NOTICE, file=sys.stderr, flush=True)
+        else:
+            warnings.warn(NOTICE.removeprefix("lynxplan: "), CompileWarning, stacklevel=1)

@@ -199,3 +199,54 @@ def test_not_a_terminal_says_nothing() -> None:
         [sys.executable, "-c", quiet, "0"], capture_output=True, text=True, timeout=120, check=True
     )
     assert done.stdout == "''"
+
+
+#: A Python program (no CLI): numba compiles two functions, the notice comes after ``after`` s.
+PROGRAM = """
+import sys, warnings
+import numba
+import lynxplan
+from lynxplan import _jit
+
+_jit.NOTICE_AFTER = float(sys.argv[1])
+if sys.argv[2] == "off":
+    _jit.disable_notices()
+_jit.listen()
+with warnings.catch_warnings(record=True) as caught:
+    warnings.simplefilter("always")
+
+    @numba.njit
+    def f(x):
+        return x + 1
+
+    @numba.njit
+    def g(x):
+        return f(x) * 2
+
+    g(1)
+    g(2.0)
+print([(w.category.__name__, str(w.message)) for w in caught
+       if issubclass(w.category, lynxplan.CompileWarning)])
+"""
+
+
+def _warnings_of_a_program(after: float, mode: str) -> list[tuple[str, str]]:
+    done = subprocess.run(
+        [sys.executable, "-c", PROGRAM, str(after), mode],
+        capture_output=True,
+        text=True,
+        timeout=120,
+        check=True,
+    )
+    return list(ast.literal_eval(done.stdout))
+
+
+def test_a_python_program_is_warned_once_of_a_long_compile() -> None:
+    """A notebook's or script's first plan compiles for minutes: a CompileWarning says so (once),
+    not a silent wait; a short compile or notices turned off say nothing."""
+    said = _warnings_of_a_program(0.0, "on")
+    assert len(said) == 1, said
+    assert said[0][0] == "CompileWarning"
+    assert said[0][1].startswith("compiling numba kernels for the first run")
+    assert _warnings_of_a_program(60.0, "on") == []
+    assert _warnings_of_a_program(0.0, "off") == []
