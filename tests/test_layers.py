@@ -189,3 +189,17 @@ def test_every_ik_tolerance_is_named_once_in_lynxplan_constants():
 
     assert constants.REACH_TOLERANCE == 1e-9  # a computed branch reaches its target
     assert constants.WRIST_SNAP_TOLERANCE == 1e-6  # a typed AL5 pose is admitted
+
+
+def test_the_ik_solvers_never_import_the_al5_package():
+    """The generic solvers serve every arm: the AL5's own package (``lynxplan.arm``) builds on
+    them, never the other way round (imports inside functions and under TYPE_CHECKING count)."""
+    graph = _import_graph(_modules(PACKAGE))
+    offenders = {
+        f"{name}: {target}"
+        for name, targets in graph.items()
+        if name.startswith("lynxplan.robots.ik.")
+        for target in targets
+        if target.startswith("lynxplan.arm")
+    }
+    assert not offenders, sorted(offenders)

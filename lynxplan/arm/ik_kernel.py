@@ -21,6 +21,7 @@ from lynxplan.constants import (
     RIGIDITY_REPAIR_TOLERANCE,
     WRIST_SNAP_TOLERANCE,
 )
+from lynxplan.robots.ik.family_geometry import wrap_into_limits
 
 TWO_PI = 2.0 * math.pi
 # No fast-math flags: the kernels give the same bits compiled and interpreted (numba's
@@ -108,23 +109,6 @@ def _orthonormalise(a: np.ndarray, n: np.ndarray, o: np.ndarray, approach_only: 
     o[0] = a[1] * n[2] - a[2] * n[1]
     o[1] = a[2] * n[0] - a[0] * n[2]
     o[2] = a[0] * n[1] - a[1] * n[0]
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
-    """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside.
-
-    By selects, no branch: array loops over it vectorise (branches outside the limits are
-    common and unpredictable in scalar loops too)."""
-    inside = (lo <= x) & (x <= hi)
-    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
-    snap_hi = y <= hi + tol
-    snap_lo = y >= lo + TWO_PI - tol
-    nearest = y if y - hi <= lo + TWO_PI - y else y - TWO_PI
-    out = lo if snap_lo else nearest
-    out = hi if snap_hi else out
-    out = y if y <= hi else out
-    return (x if inside else out), inside | snap_hi | snap_lo
 
 
 @numba.njit(cache=True, nogil=True, inline="always")

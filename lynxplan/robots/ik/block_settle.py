@@ -11,7 +11,6 @@ import numba
 import numpy as np
 
 from lynxplan._fastmath import wide_vectors
-from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.constants import (
     BLOCK_FAR_STEP,
     BLOCK_ILL_CONDITIONED,
@@ -41,6 +40,7 @@ from lynxplan.robots.ik.block_newton import (
     pose_rotation_angle,
     turn,
 )
+from lynxplan.robots.ik.family_geometry import wrap_into_limits
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)

@@ -65,6 +65,23 @@ def wrap(x: float) -> float:
     return x - TWO_PI * math.floor((x + math.pi) / TWO_PI)
 
 
+@numba.njit(cache=True, nogil=True, inline="always")
+def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float, bool]:
+    """Angle x moved by whole turns into [lo, hi] (snapping within tol), or nearest outside.
+
+    By selects, no branch: array loops over it vectorise (branches outside the limits are
+    common and unpredictable in scalar loops too)."""
+    inside = (lo <= x) & (x <= hi)
+    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI  # y in [lo, lo + 2 pi) up to rounding
+    snap_hi = y <= hi + tol
+    snap_lo = y >= lo + TWO_PI - tol
+    nearest = y if y - hi <= lo + TWO_PI - y else y - TWO_PI
+    out = lo if snap_lo else nearest
+    out = hi if snap_hi else out
+    out = y if y <= hi else out
+    return (x if inside else out), inside | snap_hi | snap_lo
+
+
 @numba.njit(cache=True, nogil=True)
 def yaw(
     prm: np.ndarray, d0: float, d1: float, d2: float, theta: float, side: int, phi_ref: float

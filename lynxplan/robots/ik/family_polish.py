@@ -12,7 +12,6 @@ import math
 import numba
 import numpy as np
 
-from lynxplan.arm.ik_kernel import wrap_into_limits
 from lynxplan.constants import CHORD_RATE, POLISH_CONDITION_TOLERANCE, POLISH_FD_STEP
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
@@ -22,6 +21,7 @@ from lynxplan.robots.ik.family_geometry import (
     MODE_POSE,
     ChainProblem,
     rotate,
+    wrap_into_limits,
 )
 
 #: Newton iterations at most (it stops below ``constants.POLISH_CONDITION_TOLERANCE``).
