@@ -214,8 +214,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _main(argv)
     argv = sys.argv[1:]
     _jit.enable_notices()  # the process is the CLI: say so when numba compiles for long
-    _jit.interpret_one_target(_command(argv), argv)  # one IK/FK target: no compile to wait for
-    if _command(argv) not in LONG_RUNNING_COMMANDS:
+    command = _command(argv)
+    _jit.interpret_one_target(command, argv)  # one IK/FK target: no compile to wait for
+    if command not in LONG_RUNNING_COMMANDS:
         young, middle, old = gc.get_threshold()
         gc.set_threshold(max(young, GC_THRESHOLD), middle, old)
     try:

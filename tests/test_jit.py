@@ -143,7 +143,20 @@ def test_one_ik_target_from_the_command_line_compiles_nothing(tmp_path) -> None:
     assert [s["q"] for s in answered] == [s.q.tolist() for s in result.solutions]
 
 
-ANNOUNCE = """
+#: Two functions numba compiles on the first call of g (the second compiles it again for a
+#: float): the compiles the notice tests watch.
+TWO_COMPILES = """
+@numba.njit
+def f(x):
+    return x + 1
+
+@numba.njit
+def g(x):
+    return f(x) * 2
+"""
+
+ANNOUNCE = (
+    """
 import io, sys
 import numba
 from lynxplan import _jit
@@ -157,19 +170,14 @@ sys.stderr = terminal
 _jit.NOTICE_AFTER = float(sys.argv[1])
 _jit.enable_notices()
 _jit.listen()
-
-@numba.njit
-def f(x):
-    return x + 1
-
-@numba.njit
-def g(x):
-    return f(x) * 2
-
+"""
+    + TWO_COMPILES
+    + """
 g(1)
 g(2.0)
 sys.__stdout__.write(repr(terminal.getvalue()))
 """
+)
 
 
 def _stderr_of_compiles(after: float) -> str:
@@ -202,7 +210,8 @@ def test_not_a_terminal_says_nothing() -> None:
 
 
 #: A Python program (no CLI): numba compiles two functions, the notice comes after ``after`` s.
-PROGRAM = """
+PROGRAM = (
+    """
 import sys, warnings
 import numba
 import lynxplan
@@ -212,22 +221,17 @@ _jit.NOTICE_AFTER = float(sys.argv[1])
 if sys.argv[2] == "off":
     _jit.disable_notices()
 _jit.listen()
+"""
+    + TWO_COMPILES
+    + """
 with warnings.catch_warnings(record=True) as caught:
     warnings.simplefilter("always")
-
-    @numba.njit
-    def f(x):
-        return x + 1
-
-    @numba.njit
-    def g(x):
-        return f(x) * 2
-
     g(1)
     g(2.0)
 print([(w.category.__name__, str(w.message)) for w in caught
        if issubclass(w.category, lynxplan.CompileWarning)])
 """
+)
 
 
 def _warnings_of_a_program(after: float, mode: str) -> list[tuple[str, str]]:

@@ -22,6 +22,7 @@ from numba.np.unsafe.ndarray import to_fixed_tuple
 from lynxplan import _fastmath
 from lynxplan._fastmath import wide_vectors
 from lynxplan.robots import family as F  # noqa: N812
+from lynxplan.robots.ik.family_geometry import two_link_shape
 
 FAST = {"contract", "arcp"}  # fused multiply-adds, reciprocals: as in ``arm.ik_kernel``
 #: Floats in registers: a pose (12, row-major 3 x 4), a Jacobian column (6), the parameters.
@@ -344,13 +345,11 @@ def link_shape(prm: np.ndarray) -> Floats:
     [m],
     their angles b2, b3 [rad], sin, cos of gamma0 and gamma0, sin and cos of b2 and of
     b2 - b3."""
-    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
-    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
+    la, lb, b2, b3 = two_link_shape(prm)
     gamma0 = prm[F.GAMMA0]
-    b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
     return (
-        math.hypot(l20, l21),
-        math.hypot(l30, l31),
+        la,
+        lb,
         b2,
         b3,
         math.sin(gamma0),

@@ -12,28 +12,13 @@ Angles are in [rad]; ``prm`` is the packed family vector of :mod:`lynxplan.robot
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
 from lynxplan._fastmath import sincos
 from lynxplan.robots import family as F  # noqa: N812
-from lynxplan.robots.ik.family_geometry import hypot
+from lynxplan.robots.ik.family_geometry import TwoLink, two_link_shape
 from lynxplan.robots.results import BranchSlots
-
-#: The two-link triangle of an arm (``two_link_shape``): the link lengths la, lb [m] and the
-#: built-in angles b2, b3 [rad] of the shoulder-elbow and elbow-wrist links.
-TwoLink = tuple[float, float, float, float]
-
-
-@numba.njit(cache=True, nogil=True)
-def two_link_shape(prm: np.ndarray) -> TwoLink:
-    """The shoulder-elbow and elbow-wrist links of the canonical arm plane: lengths [m] and
-    angles at zero joint angles [rad] (as ``family_geometry.two_link`` builds them)."""
-    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
-    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
-    return hypot(l20, l21), hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -67,14 +52,14 @@ def pair_swapped(
 
 
 @numba.njit(cache=True, nogil=True)
-def orient_elbows(prm: np.ndarray, slots: BranchSlots, rows: np.ndarray) -> None:
-    """Swap, in place, the two elbow slots (2k, 2k + 1) of each target in ``rows`` (indices)
-    where they hold their branches the wrong way round (:func:`pair_swapped`); slots of the
-    batch layout: q (N, B, 5), the others (N, B)."""
+def orient_elbows(prm: np.ndarray, slots: BranchSlots) -> None:
+    """Swap, in place, the two elbow slots (2k, 2k + 1) of each target where they hold their
+    branches the wrong way round (:func:`pair_swapped`); slots of the batch layout: q (N, B, 5),
+    the others (N, B)."""
     shape = two_link_shape(prm)
     q, valid, within = slots.q, slots.valid, slots.within
     position_error, orientation_error = slots.position_error, slots.orientation_error
-    for n in rows:
+    for n in range(valid.shape[0]):
         for b in range(0, valid.shape[1], 2):
             if not pair_swapped(prm, shape, q[n, b], valid[n, b], q[n, b + 1], valid[n, b + 1]):
                 continue

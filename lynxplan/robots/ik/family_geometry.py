@@ -192,13 +192,24 @@ def pitch_sum(
     return math.atan2(ak, ah) - prm[F.GAMMA0], out
 
 
+#: The two-link triangle of an arm (``two_link_shape``): the link lengths la, lb [m] and the
+#: angles b2, b3 [rad] of the shoulder-elbow and elbow-wrist links at zero joint angles.
+TwoLink = tuple[float, float, float, float]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def two_link_shape(prm: np.ndarray) -> TwoLink:
+    """The shoulder-elbow and elbow-wrist links in the canonical arm plane: lengths [m] and
+    angles at zero joint angles [rad]."""
+    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
+    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
+    return hypot(l20, l21), hypot(l30, l31), math.atan2(l21, l20), math.atan2(l31, l30)
+
+
 @numba.njit(cache=True, nogil=True)
 def two_link(prm: np.ndarray, x: float, y: float, elbow: int) -> tuple[float, float, float]:
     """Canonical shoulder and elbow angles reaching the wrist point (x, y); and the miss [m]."""
-    l20, l21 = prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]
-    l30, l31 = prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]
-    la, lb = hypot(l20, l21), hypot(l30, l31)
-    b2, b3 = math.atan2(l21, l20), math.atan2(l31, l30)
+    la, lb, b2, b3 = two_link_shape(prm)
     rx, ry = x - prm[F.O2], y - prm[F.O2 + 1]
     dist = hypot(rx, ry)
     cosd = (dist * dist - la * la - lb * lb) / (2.0 * la * lb)

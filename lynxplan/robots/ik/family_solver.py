@@ -106,7 +106,7 @@ def _orient(kinematics: Kinematics, out: BranchSlots) -> None:
     """Each branch the roll search and the rescue found, in the slot of its elbow (the closed
     forms place theirs: ``elbow_labels``)."""
     assert kinematics.family is not None
-    orient_elbows(kinematics.family.packed, out, np.arange(out.valid.shape[0]))
+    orient_elbows(kinematics.family.packed, out)
 
 
 def _batch(
