@@ -213,6 +213,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     if argv is not None:
         return _main(argv)
     argv = sys.argv[1:]
+    _jit.in_cli_process()
     _jit.enable_notices()  # the process is the CLI: say so when numba compiles for long
     command = _command(argv)
     _jit.interpret_one_target(command, argv)  # one IK/FK target: no compile to wait for

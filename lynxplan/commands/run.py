@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import sys
 from typing import Any
+
+from lynxplan import _jit
 
 
 def register(subparsers: Any) -> None:
@@ -48,11 +51,16 @@ def handle(args: argparse.Namespace) -> int:
             or f"out/{folder_name(read_source(args.scenario).data.get('name'), args.scenario)}"
         )
         return run_remote(args.server, args.scenario, out, quick=args.quick, force=args.force)
+    if read_source(args.scenario).data.get("kind") == "plan":
+        _jit.plan_as_python_if_cold()  # a first plan: seconds as Python, not minutes compiling
     from lynxplan.scenarios.runner import execute, load_scenario
 
     loaded = load_scenario(args.scenario)
     out = args.out or f"out/{folder_name(loaded.scenario.name, args.scenario)}"
-    result = execute(loaded, out, quick=args.quick, force=args.force)
+    try:
+        result = execute(loaded, out, quick=args.quick, force=args.force)
+    except _jit.PythonPlanTooSlowError:  # nothing written: the compiled planner's verdict instead
+        return _jit.rerun_compiled(sys.argv[1:])
     print(result.summary)
     held = sum(e.passed for e in result.expectations)
     if result.expectations:

@@ -80,6 +80,8 @@ def stack_array(rows: int, columns: int) -> Any:
     A kernel's work rows on its own stack: the compiler knows that they alias none of its
     arguments, which keeps its loops vectorised without run-time overlap checks.
     """
+    if getattr(numba.config, "DISABLE_JIT", False):  # run as Python: a fresh array
+        return lambda: np.empty((rows, columns))
 
     @intrinsic
     def allocate(typingctx: Any) -> Any:

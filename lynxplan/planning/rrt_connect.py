@@ -34,7 +34,7 @@ from typing import Any, NamedTuple
 import numba
 import numpy as np
 
-from lynxplan._jit import compile_before_timing
+from lynxplan._jit import compile_before_timing, time_limit_reached
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.edge_walk import (
@@ -463,6 +463,7 @@ def rrt_connect(
         if status == NODE_LIMIT:  # not the budget: grow, go on
             trees = trees.grown(min(limit, 2 * rows))
         elif elapsed >= time_limit:
+            time_limit_reached()  # run as Python for a first plan: planned again compiled
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )
