@@ -97,7 +97,7 @@ def primitive_poses(q: np.ndarray, model: Any, scratch: Any) -> None:
 @njit_no_refcount()
 def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> None:
     """Lower bound of the distance of every pair at q (nq,) -> out (P,), in [m] (all pairs at
-    once: :func:`lynxplan.planning.lanes.all_pair_bounds`)."""
+    once: :func:`lynxplan.planning.pair_bound.all_pair_bounds`)."""
     primitive_poses(q, model, scratch)
     all_pair_bounds(model, scratch.prim_poses, out)
 

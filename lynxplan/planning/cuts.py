@@ -82,7 +82,7 @@ def greedy_shortcuts(path: np.ndarray, count: int, check: Any) -> int:
     slacks = np.empty((count, model.pairs.shape[0]))
     known = np.zeros(count, dtype=np.bool_)
     kept = 0
-    i = np.int64(0)  # not a literal 0: numba would compile _slacks_at for it as well
+    i = np.int64(0)  # not a literal 0: numba would compile slacks_at for it as well
     while i < count - 1:
         j = count - 1
         while j > i + 1:

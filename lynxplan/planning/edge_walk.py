@@ -8,7 +8,7 @@ nothing skipped between samples.
 
 Most pairs are certified before any step, from every pair's bounds at the edge's start, its end
 and the points where quick tests of it came first (a grid: its midpoint, or its quarters),
-computed all pairs at once (:func:`lynxplan.planning.lanes.all_pair_bounds`), with the static
+computed all pairs at once (:func:`lynxplan.planning.pair_bound.all_pair_bounds`), with the static
 motion bound (:func:`_walk_start`); a pair that the grid certifies from some point to the end
 stops walking there.
 A pair that needs steps advances through several points per vectorised call
@@ -111,7 +111,7 @@ def edge_fraction_from(
 def edge_is_free_after_probes(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
-    """:func:`edge_is_free` right after the quick tests
+    """Whether the whole edge from q_a to q_b is certified, right after the quick tests
     :func:`lynxplan.planning.validity.probes_are_clear` of this edge passed (their bounds are
     the grid)."""
     walked = edge_walk(
@@ -401,14 +401,3 @@ def edge_walk(
         where[p], slack[p] = nearest, slack_t
         copy_row(all_arms, p, arms, 1)
         reach[p] = nearest + reach_step(slack_t, p, all_arms, p, model, scratch)
-
-
-@njit_no_refcount()
-def edge_is_free(
-    q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
-) -> bool:
-    """Whether the whole edge from q_a to q_b is certified (:func:`edge_fraction`)."""
-    walked = edge_walk(
-        q_a, q_b, model, scratch, clearance, np.bool_(False), np.int64(0), np.int64(ALL_JOINTS)
-    )
-    return walked >= 1.0

@@ -30,7 +30,6 @@ from lynxplan._fastmath import sincos
 from lynxplan.planning.kernel_model import (
     LANES,
     OBSTACLE_SPHERE,
-    KernelModel,
     njit_no_refcount,
     stack_array,
 )
@@ -59,11 +58,6 @@ _lane_rows = stack_array(_ROWS, LANES)
 #: parameter s (input), 2 the covering-sphere gap of the exact verification [m], 3 + j the lever
 #: arm about configuration index j [m].
 OUT_BOUND, OUT_S, OUT_SPHERE, OUT_ARMS = 0, 1, 2, 3
-
-
-def lanes_supported(model: KernelModel) -> bool:
-    """Whether :func:`pair_along` serves a kernel model (few enough joints and coordinates)."""
-    return len(model.axes) <= MAX_JOINTS and model.rates.shape[1] <= MAX_JOINTS
 
 
 @numba.njit(cache=True, inline="always", fastmath=_FAST)
@@ -262,7 +256,7 @@ def pair_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.nda
     [rad]: out[OUT_BOUND] its distance lower bound [m], out[OUT_ARMS + j] its lever arm about
     configuration index j [m]; out: (3 + nq, LANES).
 
-    The model must satisfy :func:`lanes_supported`.
+    The model has at most :data:`MAX_JOINTS` joint frames and configuration indices.
     """
     w = _lane_rows()
     _pose_pair_rows(q_a, q_b, p, model, out, w)
@@ -287,7 +281,7 @@ def spheres_along(q_a: np.ndarray, q_b: np.ndarray, p: int, model: Any, out: np.
     :func:`lynxplan.planning.sphere_gaps.sphere_gap`) [m], out[OUT_ARMS + j] its lever arm about
     configuration index j [m]; out: (3 + nq, LANES).
 
-    The model must satisfy :func:`lanes_supported`.
+    The model has at most :data:`MAX_JOINTS` joint frames and configuration indices.
     """
     w = _lane_rows()
     _pose_pair_rows(q_a, q_b, p, model, out, w)

@@ -1,6 +1,6 @@
 """The joint space: a box of joint limits, Euclidean distance, straight-line interpolation.
 
-:class:`JointSpace` for Python callers; :func:`sample`, :func:`nearest` and :func:`steer` are
+:class:`JointSpace` for Python callers; :func:`draw_sample`, :func:`nearest` and :func:`steer` are
 the same operations compiled for the planner's kernels.
 """
 

@@ -76,12 +76,12 @@ def _spheres_to_box(
 def sphere_gap(p: int, model: Any, scratch: Any) -> float:
     """Covering-sphere lower bound of pair p's distance at the poses in scratch.prim_poses, in [m].
 
-    A robot primitive lies inside the union of its covering spheres (model[17..19]) and inside
-    its box (model.prim_half: a cylinder's or a mesh hull's bounding box): the bound is the exact
-    point distance of one primitive's sphere centres from the other's box, less the spheres'
-    radius (for a self pair the larger of the two ways round), from a box obstacle the same (a
-    cylinder obstacle is stored as its bounding box, which contains it), from a sphere obstacle
-    the centres' distance less both radii.
+    A robot primitive lies inside the union of its covering spheres (model.cover_centres and
+    cover_radii) and inside its box (model.prim_half: a cylinder's or a mesh hull's bounding
+    box): the bound is the exact point distance of one primitive's sphere centres from the
+    other's box, less the spheres' radius (for a self pair the larger of the two ways round),
+    from a box obstacle the same (a cylinder obstacle is stored as its bounding box, which
+    contains it), from a sphere obstacle the centres' distance less both radii.
     """
     pairs, kinds, poses_b, obstacle_half = (
         model.pairs,

@@ -20,7 +20,7 @@ What it tests
     obstacle is replaced by its bounding box. A state is valid when every pair's bound exceeds
     the required ``clearance`` (so the exact distance does too). The bounds of all pairs of a
     state come from one vectorised kernel over all 15 axes
-    (:func:`lynxplan.planning.lanes.all_pair_bounds`); the scalar :func:`pair_bound` (one pair,
+    (:func:`lynxplan.planning.pair_bound.all_pair_bounds`); the scalar :func:`pair_bound` (one pair,
     the edge axes only when the face axes leave a small gap) serves single pairs.
 
 Edges

@@ -106,7 +106,6 @@ class ExactVerifier:
             )
             for p, (a, b, is_self) in enumerate(self._rows)
         )
-        self._self_pairs = int(world.pair_is_self.sum())
         self.queries = 0
         self._buffers = _row_buffers(_ROWS)
 
