@@ -37,6 +37,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.planning.bounds import joint_poses_upto, primitive_pose, primitive_poses
 from lynxplan.planning.kernel_model import (
     njit_no_refcount,
     njit_refcounted,
@@ -57,11 +58,6 @@ from lynxplan.planning.sphere_gaps import (
     sphere_chain,
     sphere_gap,
     sphere_grid,
-)
-from lynxplan.planning.validity import (
-    joint_poses_upto,
-    primitive_pose,
-    primitive_poses,
 )
 
 #: Smallest chain step, in units of the segment parameter s; below it the verifier bisects.

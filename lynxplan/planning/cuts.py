@@ -15,6 +15,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.planning.bounds import PROBES, point_is_clear, probes_are_clear, state_bounds
 from lynxplan.planning.edge_walk import (
     ALL_JOINTS,
     edge_fraction_from,
@@ -23,7 +24,6 @@ from lynxplan.planning.edge_walk import (
 )
 from lynxplan.planning.kernel_model import njit_no_refcount, njit_refcounted
 from lynxplan.planning.motion import copy_row
-from lynxplan.planning.validity import PROBES, point_is_clear, probes_are_clear, state_bounds
 
 #: Joints that move less than this beyond their net displacement get no partial shortcut, [rad].
 WANDER_TOLERANCE = 1e-3

@@ -57,7 +57,7 @@ def state_slacks(
 ) -> bool:
     """Every pair's bound minus the clearance at q (nq,) -> out (P,), in [m]; whether all exceed
     :data:`STALL_DISTANCE` (out is only complete when they do). The pair that failed last
-    (scratch.counters[3]) is tried alone first (:func:`lynxplan.planning.validity.first_below`)."""
+    (scratch.counters[3]) is tried alone first (:func:`lynxplan.planning.bounds.first_below`)."""
     if first_below(q, model, scratch, clearance + STALL_DISTANCE, out) != -1:
         return False
     for p in range(out.shape[0]):
@@ -92,7 +92,7 @@ def edge_fraction_from(
     """:func:`edge_fraction` with the pairs' slacks at q_a and q_b already known (slacks, two
     (P,) arrays, in [m], from :func:`state_slacks` at exactly q_a and q_b: tree nodes',
     computed once), and every pair's bound at ``points`` grid points of this edge (grid rows
-    0..points-1: quick tests :func:`lynxplan.planning.validity.point_is_clear` that passed
+    0..points-1: quick tests :func:`lynxplan.planning.bounds.point_is_clear` that passed
     just before, in increasing order of s).
 
     ``moved``: the joints (bit j: joint j) in which the edge may differ from a certified one
@@ -112,7 +112,7 @@ def edge_is_free_after_probes(
     q_a: np.ndarray, q_b: np.ndarray, model: Any, scratch: Any, clearance: float
 ) -> bool:
     """Whether the whole edge from q_a to q_b is certified, right after the quick tests
-    :func:`lynxplan.planning.validity.probes_are_clear` of this edge passed (their bounds are
+    :func:`lynxplan.planning.bounds.probes_are_clear` of this edge passed (their bounds are
     the grid)."""
     walked = edge_walk(
         q_a,

@@ -27,7 +27,7 @@ from lynxplan.collision.world import CollisionWorld
 #: (median 1.18 ms against 1.36 ms with 8, 1.27 with 6, 1.42 with 3 and 1.36 with 2).
 LANES = 4
 #: Interior points of an edge at which a walk may know every pair's bound beforehand (the quick
-#: tests before it: :func:`lynxplan.planning.validity.point_is_clear`).
+#: tests before it: :func:`lynxplan.planning.bounds.point_is_clear`).
 GRID_POINTS = 7
 #: Obstacle kinds of the kernels.
 OBSTACLE_BOX, OBSTACLE_SPHERE = 0, 1

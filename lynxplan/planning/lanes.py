@@ -3,7 +3,7 @@
 :func:`pair_along` computes, for one checked pair and :data:`LANES` parameters ``s_i`` of the
 straight joint edge ``q(s) = q_a + s (q_b - q_a)``, the same quantities as one step of the
 scalar edge walk (:func:`lynxplan.planning.motion.pose_pair_at` and
-:func:`lynxplan.planning.validity.pair_bound`): the pair's lower bound of the distance and its
+:func:`lynxplan.planning.pair_bound.pair_bound`): the pair's lower bound of the distance and its
 lever arms about each joint; :func:`spheres_along` the exact verification's sphere gap
 (:func:`lynxplan.planning.sphere_gaps.sphere_gap`) with the same lever arms. The lanes are the
 innermost loop of every computation, stored as rows of a constant-width scratch array

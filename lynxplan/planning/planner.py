@@ -17,6 +17,7 @@ import numpy as np
 from lynxplan import _jit
 from lynxplan.collision import CollisionWorld, Obstacle
 from lynxplan.exceptions import InputError, PlanningFailed, ShapeError
+from lynxplan.planning.bounds import STALL_DISTANCE
 from lynxplan.planning.certify import verification_rows
 from lynxplan.planning.problem import Goal, goal_configurations
 from lynxplan.planning.rrt_connect import RrtConnectSettings, rrt_connect
@@ -28,7 +29,7 @@ from lynxplan.planning.shortcut import (
 )
 from lynxplan.planning.space import JointSpace
 from lynxplan.planning.timing import DEFAULT_SAMPLE_RATE, METHODS, TimedPath, time_parameterize
-from lynxplan.planning.validity import STALL_DISTANCE, ValidityChecker
+from lynxplan.planning.validity import ValidityChecker
 from lynxplan.planning.verify import (
     VerificationReport,
     clear_states,

@@ -37,6 +37,7 @@ import numpy as np
 from lynxplan._jit import compile_before_timing, time_limit_reached
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
+from lynxplan.planning.bounds import point_is_clear, probes_are_clear, state_bounds
 from lynxplan.planning.edge_walk import (
     ALL_JOINTS,
     edge_fraction_from,
@@ -45,12 +46,7 @@ from lynxplan.planning.edge_walk import (
 )
 from lynxplan.planning.kernel_model import GRID_POINTS, njit_no_refcount, njit_refcounted
 from lynxplan.planning.space import draw_sample, nearest, steer
-from lynxplan.planning.validity import (
-    ValidityChecker,
-    point_is_clear,
-    probes_are_clear,
-    state_bounds,
-)
+from lynxplan.planning.validity import ValidityChecker
 
 #: Kernel status codes.
 RUNNING, SOLVED, NODE_LIMIT = 0, 1, 2
@@ -306,7 +302,7 @@ def straight_goal(
 ) -> int:
     """The first goal (K, nq) whose straight edge from start (nq,) is certified, or -1 (a
     blocked edge is usually blocked at a quarter or its midpoint: those quick tests first,
-    :func:`lynxplan.planning.validity.probes_are_clear`)."""
+    :func:`lynxplan.planning.bounds.probes_are_clear`)."""
     for k in range(goals.shape[0]):
         if probes_are_clear(
             start, goals[k], model, scratch, clearance

@@ -18,6 +18,7 @@ from typing import Any
 import numba
 import numpy as np
 
+from lynxplan.planning.bounds import joint_poses, primitive_pose
 from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE, njit_no_refcount
 from lynxplan.planning.lanes import MAX_JOINTS, OUT_ARMS, OUT_S, OUT_SPHERE, spheres_along
 from lynxplan.planning.motion import (
@@ -29,7 +30,6 @@ from lynxplan.planning.motion import (
     reach_step,
     span_motion,
 )
-from lynxplan.planning.validity import joint_poses, primitive_pose
 
 #: Sphere gaps evaluated for one pair on a segment (LANES at a time) before the exact chain is
 #: scheduled instead.

@@ -20,8 +20,9 @@ What it tests
     obstacle is replaced by its bounding box. A state is valid when every pair's bound exceeds
     the required ``clearance`` (so the exact distance does too). The bounds of all pairs of a
     state come from one vectorised kernel over all 15 axes
-    (:func:`lynxplan.planning.pair_bound.all_pair_bounds`); the scalar :func:`pair_bound` (one pair,
-    the edge axes only when the face axes leave a small gap) serves single pairs.
+    (:func:`lynxplan.planning.pair_bound.all_pair_bounds`); the scalar
+    :func:`lynxplan.planning.pair_bound.pair_bound` (one pair, the edge axes only when the face
+    axes leave a small gap) serves single pairs.
 
 Edges
     Conservative advancement along an edge: :mod:`lynxplan.planning.edge_walk`.
@@ -38,41 +39,11 @@ import numpy as np
 
 from lynxplan.collision.world import CollisionWorld
 from lynxplan.planning.bounds import (
-    PROBES,
     STALL_DISTANCE,
-    first_below,
-    joint_poses,
-    joint_poses_upto,
-    point_is_clear,
-    primitive_pose,
-    primitive_poses,
-    probes_are_clear,
     state_bounds,
-    state_clearance,
 )
 from lynxplan.planning.edge_walk import edge_fraction
 from lynxplan.planning.kernel_model import CheckData, kernel_model, make_scratch, planner_pairs
-from lynxplan.planning.pair_bound import SAT_SKIP_DISTANCE, pair_bound, pair_bound_below
-
-#: The kernels live in :mod:`lynxplan.planning.bounds` (below the edge walk, which uses them);
-#: they are imported from here too.
-__all__ = [
-    "PROBES",
-    "SAT_SKIP_DISTANCE",
-    "STALL_DISTANCE",
-    "ValidityChecker",
-    "first_below",
-    "joint_poses",
-    "joint_poses_upto",
-    "pair_bound",
-    "pair_bound_below",
-    "point_is_clear",
-    "primitive_pose",
-    "primitive_poses",
-    "probes_are_clear",
-    "state_bounds",
-    "state_clearance",
-]
 
 
 class ValidityChecker:

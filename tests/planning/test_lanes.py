@@ -8,6 +8,7 @@ from test_validity import BOUND_TOLERANCE, OBSTACLES
 
 from lynxplan.arm import Arm
 from lynxplan.collision import CollisionWorld
+from lynxplan.planning.bounds import primitive_poses
 from lynxplan.planning.kernel_model import LANES
 from lynxplan.planning.lanes import (
     OUT_ARMS,
@@ -19,7 +20,7 @@ from lynxplan.planning.lanes import (
 )
 from lynxplan.planning.pair_bound import EDGE_AXES_BELOW, all_pair_bounds, pair_bound
 from lynxplan.planning.sphere_gaps import sphere_gap
-from lynxplan.planning.validity import ValidityChecker, primitive_poses
+from lynxplan.planning.validity import ValidityChecker
 from lynxplan.planning.verify import ExactVerifier
 
 #: The vectorised and scalar kernels round differently (fused multiply-adds), in [m].

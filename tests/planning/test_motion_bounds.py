@@ -8,8 +8,9 @@ import pytest
 
 from lynxplan.arm import Arm
 from lynxplan.collision import BoxObstacle, CollisionWorld
+from lynxplan.planning.bounds import primitive_poses
 from lynxplan.planning.motion import lever_arms, reach_step, span_motion
-from lynxplan.planning.validity import ValidityChecker, primitive_poses
+from lynxplan.planning.validity import ValidityChecker
 
 #: Dense samples of each tested interval.
 SAMPLES = 60

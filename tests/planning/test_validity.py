@@ -96,8 +96,8 @@ def test_whole_edges_certified_from_the_probes_grid_are_free(
     """An edge that passes the quarter probes and is then walked with their bounds as a grid
     (pairs certified interval by interval, walks that start and stop at grid points) is free at
     a dense set of exact checks."""
+    from lynxplan.planning.bounds import probes_are_clear
     from lynxplan.planning.edge_walk import edge_is_free_after_probes
-    from lynxplan.planning.validity import probes_are_clear
 
     checker = ValidityChecker(world, 0.002)
     model, scratch = checker.model, checker.scratch

@@ -181,8 +181,8 @@ def test_covering_sphere_gaps_are_lower_bounds_of_the_exact_distances(arm: Arm) 
     every pair, self pairs and a sphere obstacle included, at random configurations; it is far
     tighter than one circumscribed sphere per primitive on the long links, which is what spares
     most exact queries."""
+    from lynxplan.planning.bounds import primitive_poses
     from lynxplan.planning.certify import sphere_gap
-    from lynxplan.planning.validity import primitive_poses
 
     ball = SphereObstacle("ball", [0.15, 0.0, 0.12], 0.03)
     world = CollisionWorld(arm, [TABLE, POST, ball], self_collision=True)
