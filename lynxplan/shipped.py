@@ -18,6 +18,14 @@ from lynxplan.exceptions import InputError
 #: Folder of the package data inside the installed package.
 DATA_FOLDER = "_data"
 
+#: The shipped AL5 URDF's file name (in ``urdf/``).
+DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
+
+
+def default_urdf_path() -> Path:
+    """Path of the shipped AL5 URDF (package data when installed, ``urdf/`` in a checkout)."""
+    return shipped_path("urdf", DEFAULT_URDF_NAME)
+
 
 def shipped_path(*parts: str) -> Path:
     """Path of a shipped file or folder, e.g. ``shipped_path("scenarios", "ok_task.yaml")``.

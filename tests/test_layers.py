@@ -191,15 +191,18 @@ def test_every_ik_tolerance_is_named_once_in_lynxplan_constants():
     assert constants.WRIST_SNAP_TOLERANCE == 1e-6  # a typed AL5 pose is admitted
 
 
-def test_the_ik_solvers_never_import_the_al5_package():
-    """The generic solvers serve every arm: the AL5's own package (``lynxplan.arm``) builds on
-    them, never the other way round (imports inside functions and under TYPE_CHECKING count)."""
+def test_the_robots_never_import_the_al5_package():
+    """The generic robots and their solvers serve every arm: the AL5's own package
+    (``lynxplan.arm``) builds on them and on the core modules they share (joint limits, IK
+    branches, shipped files), never the other way round (imports inside functions and under
+    TYPE_CHECKING count)."""
     graph = _import_graph(_modules(PACKAGE))
+    robots = [name for name in graph if name.startswith("lynxplan.robots")]
+    assert "lynxplan.robots.robot" in robots and "lynxplan.robots.ik.family_solver" in robots
     offenders = {
         f"{name}: {target}"
-        for name, targets in graph.items()
-        if name.startswith("lynxplan.robots.ik.")
-        for target in targets
+        for name in robots
+        for target in graph[name]
         if target.startswith("lynxplan.arm")
     }
     assert not offenders, sorted(offenders)

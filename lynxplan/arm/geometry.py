@@ -2,17 +2,12 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
-import numpy as np
-
+from lynxplan.joint_limits import JointLimits
 from lynxplan.units import INCH
 
-
-def _limits(*degrees: tuple[float, float]) -> np.ndarray:
-    array: np.ndarray = np.radians(np.array(degrees, dtype=float))
-    array.setflags(write=False)
-    return array
+__all__ = ["DH_FRAMES", "JOINT_NAMES", "TOOL_FRAME", "ArmGeometry", "JointLimits"]
 
 
 @dataclass(frozen=True)
@@ -43,31 +38,6 @@ class ArmGeometry:
     def max_reach(self) -> float:
         """Largest shoulder-to-tool distance, in [m] (16.5 in for the AL5)."""
         return self.a2 + self.a3 + self.d5
-
-
-@dataclass(frozen=True)
-class JointLimits:
-    """Joint position and velocity limits.
-
-    Attributes:
-        position: Lower and upper limit per joint, shape (5, 2), in [rad].
-        velocity: Largest speed per joint, shape (5,), in [rad/s].
-    """
-
-    position: np.ndarray = field(
-        default_factory=lambda: _limits((0, 180), (0, 150), (-150, 0), (0, 180), (0, 180))
-    )
-    velocity: np.ndarray = field(default_factory=lambda: np.full(5, 3.0))
-
-    @property
-    def lower(self) -> np.ndarray:
-        """Lower position limits, shape (5,), in [rad]."""
-        return self.position[:, 0]
-
-    @property
-    def upper(self) -> np.ndarray:
-        """Upper position limits, shape (5,), in [rad]."""
-        return self.position[:, 1]
 
 
 #: Joint names, in order, as in the URDF.

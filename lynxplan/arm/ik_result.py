@@ -1,58 +1,15 @@
-"""Typed results of the AL5's IK (one pose), and the selected-branch rule shared with
-``lynxplan.robots.results``."""
+"""Typed results of the AL5's IK (one pose); its branches and the selected-branch rule are every
+arm's (:mod:`lynxplan.branches`)."""
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import NamedTuple, Protocol
 
 import numpy as np
 
-from lynxplan.exceptions import NoSolutionWithinLimitsError
+from lynxplan.branches import Branch, IkSolution, selected_q
 
-
-class Branch(Protocol):
-    """What the selection rule reads of a branch."""
-
-    @property
-    def q(self) -> np.ndarray: ...
-    @property
-    def branch(self) -> str: ...
-
-
-def selected_q(solutions: Sequence[Branch], selected: int | None) -> np.ndarray:
-    """q of the selected branch.
-
-    Raises:
-        NoSolutionWithinLimitsError: if no branch is selected (none within the joint limits).
-    """
-    if selected is None:
-        raise NoSolutionWithinLimitsError(
-            "IK: no branch is within the joint limits: "
-            + "; ".join(f"{s.branch} {np.degrees(s.q).round(3).tolist()} deg" for s in solutions)
-        )
-    return solutions[selected].q
-
-
-class IkSolution(NamedTuple):
-    """One IK branch, checked by forward kinematics (the AL5's, and every Robot's as
-    ``lynxplan.robots.RobotIkSolution``).
-
-    Attributes:
-        q: Joint angles, shape (5,) (a Robot's: (n,)), in [rad] (read-only).
-        branch: Branch name, e.g. ``"front/elbow-up"`` or ``"front/roll-1/elbow-up"``.
-        within_limits: Whether q is within the joint limits (after snapping).
-        position_error: ``|p_fk(q) - p_target|``, in [m] (the miss when unreachable).
-        orientation_error: Angle between the FK rotation and the target (full pose), or between
-            the target and reached approach axes (approach, pitch targets), in [rad].
-    """
-
-    q: np.ndarray
-    branch: str
-    within_limits: bool
-    position_error: float
-    orientation_error: float
+__all__ = ["Branch", "IkResult", "IkSolution", "selected_q"]
 
 
 @dataclass(frozen=True)

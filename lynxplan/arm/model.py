@@ -18,13 +18,7 @@ from lynxplan._arrays import kernel_input
 from lynxplan.arm.configuration import as_configurations
 from lynxplan.arm.geometry import TOOL_FRAME
 from lynxplan.arm.ik_result import IkResult, IkSolution
-from lynxplan.arm.urdf import (
-    DEFAULT_URDF_NAME,
-    default_urdf_path,
-    native_stderr_captured,
-    read_geometry,
-    read_limits,
-)
+from lynxplan.arm.urdf import native_stderr_captured, read_geometry, read_limits
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
     RIGIDITY_REPAIR_TOLERANCE,
@@ -39,6 +33,7 @@ from lynxplan.exceptions import (
     ShapeError,
     UnreachablePoseError,
 )
+from lynxplan.shipped import DEFAULT_URDF_NAME, default_urdf_path
 
 __all__ = [
     "DEFAULT_URDF_NAME",

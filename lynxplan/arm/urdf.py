@@ -9,7 +9,6 @@ import sys
 import tempfile
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -17,15 +16,6 @@ import numpy as np
 from lynxplan.arm.geometry import DH_FRAMES, JOINT_NAMES, TOOL_FRAME, ArmGeometry, JointLimits
 from lynxplan.constants import URDF_STRUCTURE_TOLERANCE
 from lynxplan.exceptions import ModelError
-
-DEFAULT_URDF_NAME = "lynxmotion_al5.urdf"
-
-
-def default_urdf_path() -> Path:
-    """Path of the shipped AL5 URDF (package data when installed, ``urdf/`` in a checkout)."""
-    from lynxplan.shipped import shipped_path
-
-    return shipped_path("urdf", DEFAULT_URDF_NAME)
 
 
 @contextmanager

@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from lynxplan.exceptions import ModelError, UnknownRobotError
+from lynxplan.shipped import default_urdf_path
 
 #: SO-100 tool placement in the ``gripper`` link frame (see the module docstring).
 SO100_TOOL_TRANSLATION = (0.0, -0.1014, 0.0)
@@ -64,8 +65,6 @@ def _example_robot_data_dir() -> Path:
 
 def builtin_robots() -> dict[str, BuiltinRobot]:
     """The built-in robots by name."""
-    from lynxplan.arm.model import default_urdf_path
-
     robots = _example_robot_data_dir()
     packages = (str(robots.parent.parent),)  # package://example-robot-data/robots/...
     return {

@@ -7,7 +7,7 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lynxplan.arm.ik_result import IkSolution, selected_q
+from lynxplan.branches import IkSolution, selected_q
 
 #: One IK branch of any robot, verified by FK on the exact model: the AL5's branch type (one
 #: type for both; its ``q`` has shape (n,) here).

@@ -20,12 +20,12 @@ from typing import Any
 import numpy as np
 
 from lynxplan._arrays import kernel_input
-from lynxplan.arm.geometry import JointLimits
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
     REACH_TOLERANCE,
 )
 from lynxplan.exceptions import ShapeError, TargetError
+from lynxplan.joint_limits import JointLimits
 from lynxplan.robots import chain as _chain
 from lynxplan.robots.family import FamilyParameters, recognise_family
 from lynxplan.robots.hull_cache import geometry_model
