@@ -1,26 +1,14 @@
 """The planner's validity checker: a fast, conservative state and edge test, compiled with numba.
 
 What it tests
-    Every collision primitive of the robot (the URDF's boxes and cylinders, read through
-    :class:`lynxplan.collision.CollisionWorld`) is replaced by its oriented bounding box (a
-    cylinder by the box around it: it lies inside). For every checked pair — primitive/obstacle,
-    and primitive/primitive on non-adjacent links (the same pairs as the collision world with
-    ``self_collision=True``: two primitives are skipped when they hang on the same joint or on a
-    parent/child pair of joints, the URDF adjacency) — the checker computes a *lower bound* of the
-    Euclidean distance:
-
-    - the bounding-sphere gap ``|c_a - c_b| - r_a - r_b``, and
-    - the separating-axis gap: the largest separation of the two boxes' projections over the 15
-      axes of the separating axis theorem (box faces and edge cross products). Projection on a
-      unit vector is 1-Lipschitz, so every projected gap is a lower bound of the distance; it is
-      positive if and only if the boxes are apart (SAT), and exact when the closest features are
-      two faces or two edges.
-
-    A sphere obstacle is bounded exactly (closest point of the box minus the radius); a cylinder
-    obstacle is replaced by its bounding box. A state is valid when every pair's bound exceeds
-    the required ``clearance`` (so the exact distance does too). The bounds of all pairs of a
-    state come from one vectorised kernel over all 15 axes
-    (:func:`lynxplan.planning.pair_bound.all_pair_bounds`); the scalar
+    For every checked pair — primitive/obstacle, and primitive/primitive on non-adjacent links
+    (the same pairs as the collision world with ``self_collision=True``: two primitives are
+    skipped when they hang on the same joint or on a parent/child pair of joints, the URDF
+    adjacency) — a *lower bound* of the Euclidean distance, the one of
+    :mod:`lynxplan.planning.pair_bound` (oriented bounding boxes: sphere gap and separating
+    axes). A state is valid when every pair's bound exceeds the required ``clearance`` (so the
+    exact distance does too). The bounds of all pairs of a state come from one vectorised kernel
+    over all 15 axes (:func:`lynxplan.planning.pair_bound.all_pair_bounds`); the scalar
     :func:`lynxplan.planning.pair_bound.pair_bound` (one pair, the edge axes only when the face
     axes leave a small gap) serves single pairs.
 
