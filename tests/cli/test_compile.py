@@ -110,9 +110,15 @@ def test_pytest_plugin_says_nothing_for_kinds_without_big_kernels(tmp_path: Path
 
 @pytest.mark.slow
 def test_first_run_says_it_compiles_and_none_after_lynxplan_compile(tmp_path: Path) -> None:
-    """The whole story on an empty cache (minutes: every kernel compiles, twice over)."""
+    """The whole story on an empty cache (minutes: every kernel compiles, twice over). A first
+    plan runs as Python (one line says so, nothing compiles); the main job compiles and says so;
+    after ``lynxplan compile`` neither says anything."""
     code, said = _on_a_terminal([LYNXPLAN, "run", str(P02), "--quick", "--out",
                                  str(tmp_path / "p02")], tmp_path / "cache", 3600)  # fmt: skip
+    assert code == 0
+    assert said.count(_jit.PYTHON_PLAN_NOTE) == 1 and PLAN_KIND not in said, said
+    code, said = _on_a_terminal([LYNXPLAN, "run", str(OK_TASK), "--quick", "--out",
+                                 str(tmp_path / "ok")], tmp_path / "cache", 3600)  # fmt: skip
     assert code == 0
     assert said.count(PLAN_KIND) == 1, said
     done = subprocess.run([LYNXPLAN, "compile"], cwd=ROOT, env=_env(tmp_path / "cache"),
@@ -124,7 +130,7 @@ def test_first_run_says_it_compiles_and_none_after_lynxplan_compile(tmp_path: Pa
         command = [LYNXPLAN, "run", str(scenario), "--quick", "--out", out]
         code, said = _on_a_terminal(command, tmp_path / "cache", 600)
         assert code == 0
-        assert PLAN_KIND not in said, said
+        assert PLAN_KIND not in said and _jit.PYTHON_PLAN_NOTE not in said, said
     assert PLAN_KIND not in _pytest([P02, OK_TASK], tmp_path / "cache")
     again = subprocess.run([LYNXPLAN, "compile"], cwd=ROOT, env=_env(tmp_path / "cache"),
                            capture_output=True, text=True, timeout=900, check=False)  # fmt: skip
