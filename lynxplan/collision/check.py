@@ -23,7 +23,6 @@ Accuracy: with the default ``"coal"`` engine the clearances are exact to ~1e-10 
 
 from __future__ import annotations
 
-from functools import partial
 from typing import Any
 
 import numpy as np
@@ -166,9 +165,8 @@ def check_trajectory(
 def clearance_profile(world: CollisionWorld, q: Any) -> np.ndarray:
     """Exact clearance to each obstacle at each sample (minimum over the arm's primitives).
 
-    Branch and bound per sample (:func:`lynxplan.collision.verify.smallest_exact`): exact queries
-    only for primitives whose lower bound is below the best distance found. q: shape (N, nq), in
-    [rad] -> shape (N, n_obstacles), in [m].
+    Branch and bound per sample: exact queries only for primitives whose lower bound is below the
+    best distance found. q: shape (N, nq), in [rad] -> shape (N, n_obstacles), in [m].
     """
     config = _configurations(guards.configurations("q", q, dof=world.model.nq), world.model.nq)
     poses = world.primitive_poses(config)
@@ -176,15 +174,16 @@ def clearance_profile(world: CollisionWorld, q: Any) -> np.ndarray:
     profile = np.full((len(config), len(world.obstacles)), np.inf)
     for o in range(len(world.obstacles)):
         pairs = np.flatnonzero(~world.pair_is_self & (world.pair_other == o))
-        for n, pose in enumerate(poses):
-            exact = partial(_pair_distance, world, pose, pairs)
-            profile[n, o] = smallest_exact(bounds[n, pairs], exact)[0]
+        order = np.argsort(bounds[:, pairs], axis=1)
+        for n in range(len(config)):
+            best = np.inf
+            for pair in pairs[order[n]].tolist():
+                bound = bounds[n, pair]
+                if bound >= best and bound > 0:
+                    break
+                best = min(best, world.distance(poses[n], pair))
+            profile[n, o] = best
     return profile
-
-
-def _pair_distance(world: CollisionWorld, pose: np.ndarray, pairs: np.ndarray, i: int) -> float:
-    """Exact distance of the pair ``pairs[i]`` at one sample's primitive poses, in [m]."""
-    return float(world.distance(pose, int(pairs[i])))
 
 
 def _check_times(t: Any, segment: Any, count: int) -> tuple[np.ndarray, np.ndarray]:
