@@ -19,8 +19,8 @@ about two minutes for the planner on a small machine.
 - :func:`plan_as_python_if_cold` (the CLI's ``run`` of a plan scenario) does the same for a
   plan while the planner's kernels (:data:`PLANNER_KERNELS`) have no compiled version: the
   shipped plans take 1-6 s as Python against ~1.5 min of compiling, with the same paths to the
-  bit. A plan that reaches its time limit as Python is planned again compiled
-  (:class:`PythonPlanTooSlowError`, :func:`rerun_compiled`): the verdict never depends on the cache.
+  bit. A plan that reaches its time limit (or :data:`PYTHON_PLAN_SECONDS`) as Python is planned
+  again compiled (:class:`PythonPlanTooSlowError`): the verdict never depends on the cache.
 - :func:`cold_kernels` tells, before anything runs, which of the big kernels
   (:data:`ENTRY_KERNELS`) have no version in numba's cache for their current source: the pytest
   plugin and ``lynxplan serve`` say :data:`NOTICE` up front when some do. ``lynxplan compile``
@@ -29,20 +29,16 @@ about two minutes for the planner on a small machine.
 
 from __future__ import annotations
 
-import ast
 import importlib
 import os
-import pickle
-import pickletools
-import subprocess
 import sys
 import threading
 import time
-import types
 import warnings
 from collections.abc import Callable
-from pathlib import Path
 from typing import Any
+
+from lynxplan._numba_cache import cached
 
 #: Seconds of compiling after which the wait is explained on stderr.
 NOTICE_AFTER = 3.0
@@ -73,7 +69,11 @@ ENTRY_KERNELS = (
 #: The planner's entry kernels: a plan compiles them all (:func:`plan_as_python_if_cold`).
 PLANNER_KERNELS = tuple(k for k in ENTRY_KERNELS if k.startswith("lynxplan.planning."))
 
-#: The note of a plan run as Python code (the CLI, on a terminal).
+#: Seconds of planning as Python after which the CLI plans again compiled (~100x faster), even
+#: where the plan's time limit is longer: compiling takes about as long.
+PYTHON_PLAN_SECONDS = 20.0
+
+#: The note of a plan run as Python code (the CLI's stderr).
 PYTHON_PLAN_NOTE = (
     "lynxplan: planning as Python code: the planner's compiled kernels are not built yet "
     "(`lynxplan compile` builds them once, about 3 min on 2 cores; plans then run ~100x faster)"
@@ -116,8 +116,8 @@ def cold_kernels(kernels: tuple[str, ...] = ENTRY_KERNELS) -> list[str]:
     """The kernels among ``kernels`` ("module:name", numba dispatchers with ``cache=True``) that
     have no compiled version in numba's on-disk cache for their current source file (its index
     file, next to the source or under ``NUMBA_CACHE_DIR``, is missing, empty, from another numba
-    version, or older than the source): :func:`cached`. Imports numba, not the kernels'
-    modules; reads one small index file per kernel (a few ms in all)."""
+    version, older than the source, or compiled for another CPU): ``_numba_cache.cached``.
+    Imports numba, not the kernels' modules; reads one small index file per kernel."""
     return [kernel for kernel in kernels if not cached(kernel)]
 
 
@@ -153,8 +153,10 @@ def interpret_one_target(command: str | None, argv: list[str]) -> bool:
 
 
 class PythonPlanTooSlowError(Exception):
-    """A plan run as Python by :func:`plan_as_python_if_cold` reached its time limit: the CLI
-    plans again compiled (:func:`rerun_compiled`). Never reaches a user."""
+    """A plan run as Python by :func:`plan_as_python_if_cold` reached its time limit or
+    :data:`PYTHON_PLAN_SECONDS`: the CLI plans again compiled (``lynxplan.commands.run``). Not a
+    ``LynxplanError`` on purpose: the scenario layer turns those into a failed run, and this one
+    must reach the command, before anything is written. Never reaches a user."""
 
 
 def plan_as_python_if_cold() -> bool:
@@ -177,79 +179,25 @@ def plan_as_python_if_cold() -> bool:
     reload: Any = config.reload_config
     reload()
     _state["python_plan"] = True
-    if _state["notices"]:
-        print(PYTHON_PLAN_NOTE, file=sys.stderr, flush=True)
+    print(PYTHON_PLAN_NOTE, file=sys.stderr, flush=True)  # terminal or log: say why it is slow
     return True
 
 
-def time_limit_reached() -> None:
-    """Called by the planner when its time limit is reached: raises
+def check_python_plan(elapsed: float, time_limit: float) -> None:
+    """Called by the planner between its compiled chunks: raises
     :class:`PythonPlanTooSlowError` when the plan runs as Python by :func:`plan_as_python_if_cold`
-    (compiled, ~100x faster, it may have been solved in time)."""
-    if _state["python_plan"]:
+    and has used its time limit or :data:`PYTHON_PLAN_SECONDS` (compiled, ~100x faster, it may
+    have been solved in time). elapsed, time_limit: [s]."""
+    if _state["python_plan"] and elapsed >= min(time_limit, PYTHON_PLAN_SECONDS):
         raise PythonPlanTooSlowError
 
 
-def rerun_compiled(argv: list[str]) -> int:
-    """Run the CLI again with ``argv`` in a new process with numba's compiler on (it compiles
-    the planner, once); returns its exit code."""
-    sys.stderr.write(
-        "lynxplan: the plan reached its time limit as Python code: planning again compiled\n"
-    )
-    sys.stderr.flush()
-    program = "import sys; from lynxplan.cli import main; sys.exit(main())"
-    environment = {**os.environ, "NUMBA_DISABLE_JIT": "0"}
-    done = subprocess.run([sys.executable, "-c", program, *argv], env=environment, check=False)
-    return done.returncode
-
-
-def cached(kernel: str) -> bool:
-    """Whether numba's on-disk cache holds a version of ``kernel`` ("module:name", a top-level
-    ``cache=True`` kernel of a lynxplan module) for its current source, as numba would load it,
-    without importing the module: the index file is located from the source (the function's
-    first line) with numba's own cache classes, and its numba version and source stamp are read
-    without unpickling its signatures (they name lynxplan's types: unpickling imports them)."""
-    from numba.core import caching
-
-    module, name = kernel.split(":")
-    path = Path(__file__).parent.joinpath(*module.split(".")[1:]).with_suffix(".py")
-    tree = ast.parse(path.read_text(encoding="utf-8"))
-    node = next(n for n in tree.body if isinstance(n, ast.FunctionDef) and n.name == name)
-    first = min([node.lineno, *(d.lineno for d in node.decorator_list)])
-    code = _stand_in.__code__.replace(co_filename=str(path), co_firstlineno=first, co_name=name)
-    stand_in = types.FunctionType(code, {}, name)
-    stand_in.__qualname__ = name
-    function_cache: Any = caching.FunctionCache
-    index: Any = function_cache(stand_in)._cache_file
-    stamp = index._source_stamp  # numba >= 0.64: a hash of the source; older: (mtime, size)
-    parts = list(stamp) if isinstance(stamp, tuple) else [stamp]
-    try:
-        with open(index._index_path, "rb") as file:
-            version = pickle.load(file)  # a str
-            written = _leading_values(file.read(), len(parts))  # the stamp, then the signatures
-    except (OSError, pickle.UnpicklingError, EOFError, ValueError):
-        return False
-    return bool(version == index._version and written == parts)
-
-
-def _leading_values(data: bytes, count: int) -> list[Any]:
-    """The first ``count`` values (numbers, strings, bytes) a pickle stream pushes, read without
-    running it."""
-    values: list[Any] = []
-    for opcode, argument, _position in pickletools.genops(data):
-        if argument is not None and opcode.name not in _NOT_VALUES:
-            values.append(argument)
-            if len(values) == count:
-                break
-    return values
-
-
-#: Pickle opcodes whose argument is no value of the stream.
-_NOT_VALUES = frozenset({"PROTO", "FRAME", "GET", "BINGET", "LONG_BINGET", "PUT", "BINPUT"})
-
-
-def _stand_in() -> None:
-    """The code object :func:`cached` renames after a kernel."""
+def kernels_run_as_python() -> bool:
+    """Whether this process runs lynxplan's numba kernels as Python (numba's
+    ``NUMBA_DISABLE_JIT``: :func:`plan_as_python_if_cold`, :func:`interpret_one_target` or the
+    user's own setting)."""
+    numba = sys.modules.get("numba")
+    return bool(getattr(getattr(numba, "config", None), "DISABLE_JIT", False))
 
 
 def in_cli_process() -> None:

@@ -34,7 +34,7 @@ from typing import Any, NamedTuple
 import numba
 import numpy as np
 
-from lynxplan._jit import compile_before_timing, time_limit_reached
+from lynxplan._jit import check_python_plan, compile_before_timing
 from lynxplan.exceptions import PlanningFailed
 from lynxplan.planning import rng as _rng
 from lynxplan.planning.bounds import point_is_clear, probes_are_clear, state_bounds
@@ -451,6 +451,7 @@ def rrt_connect(
     began += compile_before_timing(_solution, (trees.nodes, trees.parents, meta))
     while status != SOLVED:
         elapsed = time.perf_counter() - began
+        check_python_plan(elapsed, time_limit)  # a first plan run as Python: compiled instead
         rows = trees.nodes.shape[1]
         if status == NODE_LIMIT and rows >= limit:
             raise PlanningFailed(
@@ -459,7 +460,6 @@ def rrt_connect(
         if status == NODE_LIMIT:  # not the budget: grow, go on
             trees = trees.grown(min(limit, 2 * rows))
         elif elapsed >= time_limit:
-            time_limit_reached()  # run as Python for a first plan: planned again compiled
             raise PlanningFailed(
                 int(counts.sum()), int(meta[3]), elapsed, f"time limit {time_limit:g} s reached"
             )

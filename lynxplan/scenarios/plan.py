@@ -55,6 +55,7 @@ from typing import Annotated, Any, ClassVar, Literal
 import numpy as np
 from pydantic import Field
 
+from lynxplan._jit import kernels_run_as_python
 from lynxplan.scenarios.base import (
     SI_UNITS,
     Finite,
@@ -324,6 +325,8 @@ def run(scenario: Input, *, quick: bool = False) -> KindOutput:
         "verification_probes_min_clearance": trajectory.verification.min_clearance._asdict(),
         "limit_violations": limits,
         "stats": {**trajectory.stats.__dict__, "solve_time": trajectory.stats.solve_time},
+        # planning_time's kernels: "python" on a first run from the command line (_jit)
+        "kernels": "python" if kernels_run_as_python() else "compiled",
         "verification": {
             "self_collision_pairs": trajectory.verification.self_collision_pairs,
             "obstacle_pairs": trajectory.verification.obstacle_pairs,
