@@ -54,11 +54,12 @@ def handle(args: argparse.Namespace) -> int:
             or f"out/{folder_name(read_source(args.scenario).data.get('name'), args.scenario)}"
         )
         return run_remote(args.server, args.scenario, out, quick=args.quick, force=args.force)
-    if _may_run_as_python(read_source(args.scenario).data):
+    source = read_source(args.scenario)
+    if _may_run_as_python(source.data):
         _jit.plan_as_python_if_cold()  # a first plan: seconds as Python, not minutes compiling
-    from lynxplan.scenarios.runner import execute, load_scenario
+    from lynxplan.scenarios.runner import execute, validate
 
-    loaded = load_scenario(args.scenario)
+    loaded = validate(source)
     out = args.out or f"out/{folder_name(loaded.scenario.name, args.scenario)}"
     try:
         result = execute(loaded, out, quick=args.quick, force=args.force)
@@ -76,8 +77,6 @@ def handle(args: argparse.Namespace) -> int:
         return 1
     return 0
 
-
-_MAIN = "from lynxplan.cli import main; sys.exit(main())"
 
 #: Samples per second up to which a plan scenario may run as Python on a cold cache (the
 #: trajectory's exact clearance is computed at every sample: 10x the default 100 Hz).
@@ -107,6 +106,9 @@ def _rerun_compiled(argv: list[str]) -> int:
     paths = [root, *filter(None, [os.environ.get("PYTHONPATH")])]
     environment = {**os.environ, "NUMBA_DISABLE_JIT": "0", "PYTHONPATH": os.pathsep.join(paths)}
     # without the working folder python -c puts first: the lynxplan of PYTHONPATH, this one
-    program = "import sys; sys.path[:] = [p for p in sys.path if p]; " + _MAIN
+    program = (
+        "import sys; sys.path[:] = [p for p in sys.path if p]; "
+        "from lynxplan.cli import main; sys.exit(main())"
+    )
     done = subprocess.run([sys.executable, "-c", program, *argv], env=environment, check=False)
     return done.returncode if done.returncode >= 0 else 128 - done.returncode

@@ -18,6 +18,7 @@ import numpy as np
 from numba.core import types
 from numba.extending import intrinsic
 
+from lynxplan._jit import kernels_run_as_python
 from lynxplan.collision.obstacles import BoxObstacle, CylinderObstacle, SphereObstacle
 from lynxplan.collision.world import CollisionWorld
 
@@ -80,7 +81,7 @@ def stack_array(rows: int, columns: int) -> Any:
     A kernel's work rows on its own stack: the compiler knows that they alias none of its
     arguments, which keeps its loops vectorised without run-time overlap checks.
     """
-    if getattr(numba.config, "DISABLE_JIT", False):  # run as Python: a fresh array
+    if kernels_run_as_python():  # a fresh array
         return lambda: np.empty((rows, columns))
 
     @intrinsic

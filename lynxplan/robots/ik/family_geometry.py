@@ -18,6 +18,7 @@ from typing import cast
 import numba
 import numpy as np
 
+from lynxplan._jit import kernels_run_as_python
 from lynxplan.robots import family as F  # noqa: N812
 
 MODE_POSE, MODE_APPROACH, MODE_PITCH = 0, 1, 2
@@ -43,8 +44,7 @@ def _libm_hypot() -> Callable[[float, float], float]:
 #: sqrt(x^2 + y^2) without overflow, the same bits compiled and interpreted: compiled kernels
 #: call the C library's ``hypot`` for ``math.hypot``; under numba's ``NUMBA_DISABLE_JIT`` (the
 #: command line's single-target ``ik``) the kernels are Python and call it through ctypes.
-_INTERPRETED: bool = getattr(numba.config, "DISABLE_JIT", False)
-hypot: Callable[[float, float], float] = _libm_hypot() if _INTERPRETED else math.hypot
+hypot: Callable[[float, float], float] = _libm_hypot() if kernels_run_as_python() else math.hypot
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
