@@ -76,19 +76,6 @@ def select_continuous(
 
 
 @numba.njit(cache=True, nogil=True)
-def _rotation_angle(target: np.ndarray, reached: np.ndarray) -> float:
-    """Angle of target^T reached for 3x3 blocks of 4x4 arrays, in [rad]."""
-    return _angle_between_frames(
-        target[:3, 0].copy(),
-        target[:3, 1].copy(),
-        target[:3, 2].copy(),
-        reached[:3, 0].copy(),
-        reached[:3, 1].copy(),
-        reached[:3, 2].copy(),
-    )
-
-
-@numba.njit(cache=True, nogil=True)
 def ik_single_kernel(
     T: np.ndarray,
     q_ref: np.ndarray,

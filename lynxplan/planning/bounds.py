@@ -103,17 +103,6 @@ def state_bounds(q: np.ndarray, model: Any, scratch: Any, out: np.ndarray) -> No
 
 
 @njit_no_refcount()
-def state_clearance(q: np.ndarray, model: Any, scratch: Any) -> float:
-    """Smallest pair bound at q (nq,), in [m] (inf without pairs)."""
-    bounds = scratch.grid[0]
-    state_bounds(q, model, scratch, bounds)
-    best = np.inf
-    for p in range(bounds.shape[0]):
-        best = min(best, bounds[p])
-    return best
-
-
-@njit_no_refcount()
 def first_below(q: np.ndarray, model: Any, scratch: Any, threshold: float, out: np.ndarray) -> int:
     """Every pair's bound at q (nq,) -> out (P,), in [m], and the first pair whose bound is at
     most ``threshold`` [m] (-1: none). The pair that failed last (scratch.counters[3]) is tried

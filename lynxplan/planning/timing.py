@@ -25,7 +25,7 @@ import numpy as np
 from lynxplan import guards
 from lynxplan.exceptions import InputError, RetimingError
 from lynxplan.trajectory.lspb import unit_lspb
-from lynxplan.trajectory.ruckig_samples import ruckig_states
+from lynxplan.trajectory.ruckig_samples import rest_to_rest, ruckig_states
 from lynxplan.trajectory.timing import auto_timing_linear, samples_implied
 
 METHODS = ("ruckig", "lspb", "toppra")
@@ -64,21 +64,8 @@ def _unit_limits(limits: tuple[np.ndarray, ...], delta: np.ndarray) -> list[floa
 def _ruckig_law(
     delta: np.ndarray, velocity: np.ndarray, acceleration: np.ndarray, jerk: np.ndarray, rate: float
 ) -> tuple[np.ndarray, ...]:
-    from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
-
-    params = InputParameter(1)
-    params.current_position, params.target_position = [0.0], [1.0]
-    params.current_velocity = params.current_acceleration = [0.0]
-    params.target_velocity = params.target_acceleration = [0.0]
     v, a, j = _unit_limits((velocity, acceleration, jerk), delta)
-    params.max_velocity, params.max_acceleration, params.max_jerk = [v], [a], [j]
-    trajectory = Trajectory(1)
-    try:
-        result = Ruckig(1).calculate(params, trajectory)
-    except RuckigError as exc:
-        raise RetimingError("ruckig", str(exc).strip().splitlines()[0]) from exc
-    if result not in (Result.Working, Result.Finished):
-        raise RetimingError("ruckig", str(result))
+    trajectory = rest_to_rest([0.0], [1.0], ([v], [a], [j]))
     t = _times(float(trajectory.duration), rate)
     s, sd, sdd = ruckig_states(trajectory, t)
     return t, s[:, 0], sd[:, 0], sdd[:, 0]

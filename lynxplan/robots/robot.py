@@ -112,7 +112,6 @@ class Robot:
         )
         self.family: FamilyParameters | None = family
         self.family_reason = reason
-        self._zero_reference = np.clip(np.zeros((1, self.nq)), self.limits.lower, self.limits.upper)
         self.kinematics = Kinematics(self.chain, family, self.limits.lower, self.limits.upper)
 
     # -- description ------------------------------------------------------------------------

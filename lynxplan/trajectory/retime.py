@@ -35,7 +35,7 @@ from lynxplan.trajectory.limits import MotionLimits
 from lynxplan.trajectory.line import LineSegment
 from lynxplan.trajectory.lspb import LspbTiming
 from lynxplan.trajectory.plan import DEFAULT_SAMPLE_RATE, Plan
-from lynxplan.trajectory.ruckig_samples import ruckig_states
+from lynxplan.trajectory.ruckig_samples import rest_to_rest, ruckig_states
 from lynxplan.trajectory.timing import auto_timing_linear, auto_timing_path, samples_implied
 
 METHODS = ("lspb", "lspb_auto", "ruckig", "ruckig_lspb_duration", "toppra")
@@ -147,25 +147,16 @@ def ruckig_profile(
         rate: Sample rate, in [Hz].
         minimum_duration: Force at least this duration, in [s] (e.g. the LSPB's tt).
     """
-    from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
-
-    params = InputParameter(5)
-    params.current_position = list(map(float, q_start))
-    params.target_position = list(map(float, q_end))
-    params.current_velocity = params.current_acceleration = [0.0] * 5
-    params.target_velocity = params.target_acceleration = [0.0] * 5
-    params.max_velocity = list(map(float, limits.velocity))
-    params.max_acceleration = list(map(float, limits.acceleration))
-    params.max_jerk = list(map(float, limits.jerk))
-    if minimum_duration is not None:
-        params.minimum_duration = float(minimum_duration)
-    trajectory = Trajectory(5)
-    try:
-        result = Ruckig(5).calculate(params, trajectory)
-    except RuckigError as exc:
-        raise RetimingError("ruckig", str(exc).strip().splitlines()[0]) from exc
-    if result not in (Result.Working, Result.Finished):
-        raise RetimingError("ruckig", str(result))
+    trajectory = rest_to_rest(
+        list(map(float, q_start)),
+        list(map(float, q_end)),
+        (
+            list(map(float, limits.velocity)),
+            list(map(float, limits.acceleration)),
+            list(map(float, limits.jerk)),
+        ),
+        minimum_duration,
+    )
     t = sample_times(trajectory.duration, rate)
     position, velocity, acceleration = ruckig_states(trajectory, t)
     return Profile(t, position, velocity, acceleration, requested_duration=minimum_duration)

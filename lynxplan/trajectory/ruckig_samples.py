@@ -1,4 +1,5 @@
-"""Sampling a ruckig trajectory at many times in one compiled evaluation.
+"""Ruckig's rest-to-rest motions (:func:`rest_to_rest`) and their samples at many times in one
+compiled evaluation (:func:`ruckig_states`).
 
 ``ruckig.Trajectory.at_time`` costs about 1.4 us per call from Python, and a trajectory sampled
 at 100 Hz needs one call per sample: most of the time of a planned path's time-parameterisation
@@ -12,6 +13,41 @@ from typing import Any
 
 import numba
 import numpy as np
+
+from lynxplan.exceptions import RetimingError
+
+
+def rest_to_rest(
+    start: list[float],
+    end: list[float],
+    limits: tuple[list[float], list[float], list[float]],
+    minimum_duration: float | None = None,
+) -> Any:
+    """Ruckig's time-optimal jerk-limited motion from rest at ``start`` to rest at ``end``
+    (dofs each), within ``limits`` = (velocity, acceleration, jerk) per dof; at least
+    ``minimum_duration`` [s] where given. Returns the ``ruckig.Trajectory``.
+
+    Raises:
+        RetimingError: ruckig rejects the input or finds no trajectory.
+    """
+    from ruckig import InputParameter, Result, Ruckig, RuckigError, Trajectory
+
+    dofs = len(start)
+    params = InputParameter(dofs)
+    params.current_position, params.target_position = start, end
+    params.current_velocity = params.current_acceleration = [0.0] * dofs
+    params.target_velocity = params.target_acceleration = [0.0] * dofs
+    params.max_velocity, params.max_acceleration, params.max_jerk = limits
+    if minimum_duration is not None:
+        params.minimum_duration = float(minimum_duration)
+    trajectory = Trajectory(dofs)
+    try:
+        result = Ruckig(dofs).calculate(params, trajectory)
+    except RuckigError as exc:
+        raise RetimingError("ruckig", str(exc).strip().splitlines()[0]) from exc
+    if result not in (Result.Working, Result.Finished):
+        raise RetimingError("ruckig", str(result))
+    return trajectory
 
 
 @numba.njit(cache=True, nogil=True)

@@ -82,20 +82,41 @@ def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float,
     return (x if inside else out), inside | snap_hi | snap_lo
 
 
-@numba.njit(cache=True, nogil=True)
-def yaw(
-    prm: np.ndarray, d0: float, d1: float, d2: float, theta: float, side: int, phi_ref: float
-) -> tuple[float, float]:
-    """Canonical yaw angle phi of one side for roll theta, and the lateral miss [m]."""
+@numba.njit(cache=True, nogil=True, inline="always")
+def from_yaw_axis(prm: np.ndarray, target: np.ndarray) -> tuple[float, float, float]:
+    """The target's (4, 4) tool point from the yaw axis's point C1 (3) [m]."""
+    return target[0, 3] - prm[F.C1], target[1, 3] - prm[F.C1 + 1], target[2, 3] - prm[F.C1 + 2]
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def across_yaw_axis(prm: np.ndarray, d0: float, d1: float, d2: float) -> tuple[float, float, float]:
+    """(dp, dh, rho): the components of d (from ``from_yaw_axis``) along p and h, and its
+    distance from the yaw axis [m]."""
     dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
     dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
-    lat = (
+    return dp, dh, hypot(dp, dh)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def lateral_offset(prm: np.ndarray, theta: float) -> float:
+    """The tool point's offset along the pitch axis from the yaw axis at roll theta [m]: the
+    distance from the yaw axis the yaw must give the target."""
+    lat: float = (
         prm[F.LAM4]
         + prm[F.W0 + 2]
         + math.cos(theta) * prm[F.E1 + 2]
         + math.sin(theta) * prm[F.E2 + 2]
     )
-    rho = hypot(dp, dh)
+    return lat
+
+
+@numba.njit(cache=True, nogil=True)
+def yaw(
+    prm: np.ndarray, d0: float, d1: float, d2: float, theta: float, side: int, phi_ref: float
+) -> tuple[float, float]:
+    """Canonical yaw angle phi of one side for roll theta, and the lateral miss [m]."""
+    dp, dh, rho = across_yaw_axis(prm, d0, d1, d2)
+    lat = lateral_offset(prm, theta)
     if rho <= 1e-12 and abs(lat) <= 1e-12:  # on the yaw axis: any yaw; keep the reference
         return phi_ref + side * math.pi, 0.0
     ratio, miss = lat / rho if rho > 0 else math.copysign(1.0, lat), 0.0
@@ -236,11 +257,7 @@ def branch(problem: RollProblem, pitch: float, theta: float, elbow: int, out: np
     """Joint angles of one branch (one side of ``problem``) for roll theta into out (5,);
     pitch [rad] for pitch targets. Returns the reach miss [m]."""
     prm, target, g, mode, side, phi_ref, sum_ref = problem
-    d0, d1, d2 = (
-        target[0, 3] - prm[F.C1],
-        target[1, 3] - prm[F.C1 + 1],
-        target[2, 3] - prm[F.C1 + 2],
-    )
+    d0, d1, d2 = from_yaw_axis(prm, target)
     phi, lat_miss = yaw(prm, d0, d1, d2, theta, side, phi_ref)
     big_phi, _ = pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], pitch, phi, sum_ref)
     if mode == MODE_POSE and prm[F.OFF_AXIS] == 0.0:

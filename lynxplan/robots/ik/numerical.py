@@ -61,6 +61,30 @@ def _approach_rows(pose: np.ndarray, jac: np.ndarray, u: np.ndarray) -> None:
 
 
 @numba.njit(cache=True, nogil=True)
+def _linearised(
+    arm: NumericalArm,
+    q: np.ndarray,
+    target: np.ndarray,
+    approach_only: bool,
+    frames: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    e: np.ndarray,
+) -> float:
+    """The pose and Jacobian at q (n,) [rad] into frames = (pose (4, 4), jac (6, n), and the
+    FK's scratch (4, 4), (n, 6)), the error against the target into e (6,) (``_error``; for
+    ``approach_only`` the Jacobian's angular rows are the approach axis's rates); returns the
+    squared error's sum."""
+    pose, jac, work, origins = frames
+    chain_fk_jacobian(arm.placements, arm.axes, q, pose, jac, work, origins)
+    if approach_only:
+        _approach_rows(pose, jac, arm.approach_axis)
+    _error(pose, target, approach_only, e, arm.approach_axis)
+    cost = 0.0
+    for i in range(6):
+        cost += e[i] * e[i]
+    return cost
+
+
+@numba.njit(cache=True, nogil=True)
 def _angle(pose: np.ndarray, target: np.ndarray, approach_only: bool, u: np.ndarray) -> float:
     if approach_only:
         a0 = pose[0, 0] * u[0] + pose[0, 1] * u[1] + pose[0, 2] * u[2]
@@ -144,9 +168,8 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
     placements, axes, lower, upper, approach_axis = arm
     q_out, success, position_error, orientation_error, iterations = result
     n = axes.shape[0]
-    pose, work = np.empty((4, 4)), np.empty((4, 4))
-    jac = np.empty((6, n))
-    origins = np.empty((n, 6))
+    frames = (np.empty((4, 4)), np.empty((6, n)), np.empty((4, 4)), np.empty((n, 6)))
+    pose, jac, work, origins = frames
     e, e_new = np.empty(6), np.empty(6)
     q, q_new = np.empty(n), np.empty(n)
     a = np.empty((n + 1, n))  # the normal equations, then their LU factors (``lu_factor``)
@@ -164,13 +187,7 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
             for j in range(n):
                 q[j] = min(max(q[j], lower[j]), upper[j])
             lam = 1e-3
-            chain_fk_jacobian(placements, axes, q, pose, jac, work, origins)
-            if approach_only:
-                _approach_rows(pose, jac, approach_axis)
-            _error(pose, target, approach_only, e, approach_axis)
-            cost = 0.0
-            for i in range(6):
-                cost += e[i] * e[i]
+            cost = _linearised(arm, q, target, approach_only, frames, e)
             for _ in range(MAX_ITERATIONS):
                 total += 1
                 if cost < 1e-26:
@@ -189,13 +206,7 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
                 lu_solve(a, b, step)
                 for j in range(n):
                     q_new[j] = min(max(q[j] + step[j], lower[j]), upper[j])
-                chain_fk_jacobian(placements, axes, q_new, pose, jac, work, origins)
-                if approach_only:
-                    _approach_rows(pose, jac, approach_axis)
-                _error(pose, target, approach_only, e_new, approach_axis)
-                new_cost = 0.0
-                for i in range(6):
-                    new_cost += e_new[i] * e_new[i]
+                new_cost = _linearised(arm, q_new, target, approach_only, frames, e_new)
                 if new_cost < cost:
                     q[:] = q_new
                     e[:] = e_new

@@ -43,8 +43,10 @@ from lynxplan.robots.chain import chain_fk, chain_fk_jacobian
 from lynxplan.robots.ik.elbow_labels import orient_table
 from lynxplan.robots.ik.family_geometry import (
     MODE_POSE,
+    across_yaw_axis,
     best_roll,
     branch,
+    from_yaw_axis,
     hypot,
     pitch_sum,
     wrap,
@@ -256,13 +258,8 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
     a_p = g[0, 3] * prm[F.P] + g[1, 3] * prm[F.P + 1] + g[2, 3] * prm[F.P + 2]
     if hypot(a_h, a_p) <= AXIAL_APPROACH:
         return False
-    d0 = target[0, 3] - prm[F.C1]
-    d1 = target[1, 3] - prm[F.C1 + 1]
-    d2 = target[2, 3] - prm[F.C1 + 2]
-    rho = hypot(
-        d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2],
-        d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2],
-    )
+    d0, d1, d2 = from_yaw_axis(prm, target)
+    rho = across_yaw_axis(prm, d0, d1, d2)[2]
     axial = hypot(a_h, a_p)
     reach = hypot(prm[F.O3] - prm[F.O2], prm[F.O3 + 1] - prm[F.O2 + 1]) + hypot(
         prm[F.O4] - prm[F.O3], prm[F.O4 + 1] - prm[F.O3 + 1]

@@ -21,8 +21,10 @@ from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.family_geometry import (
     MODE_APPROACH,
     RollProblem,
+    across_yaw_axis,
     best_roll,
-    hypot,
+    from_yaw_axis,
+    lateral_offset,
     pitch_sum,
     yaw,
 )
@@ -36,11 +38,7 @@ def reference_terms(problem: RollProblem, theta: float) -> tuple[float, float, f
     ``g[:3, :3]`` is G = Rt Rt0^T, ``g[:3, 3]`` the target approach axis.
     """
     prm, target, g, mode, side, phi_ref, sum_ref = problem
-    d0, d1, d2 = (
-        target[0, 3] - prm[F.C1],
-        target[1, 3] - prm[F.C1 + 1],
-        target[2, 3] - prm[F.C1 + 2],
-    )
+    d0, d1, d2 = from_yaw_axis(prm, target)
     phi, miss = yaw(prm, d0, d1, d2, theta, side, phi_ref)
     big_phi, out = pitch_sum(prm, mode, g[0, 3], g[1, 3], g[2, 3], 0.0, phi, sum_ref)
     if mode == MODE_APPROACH:
@@ -60,12 +58,8 @@ SCRATCH_ROWS = 9
 @numba.njit(cache=True, nogil=True)
 def prepare_roll_terms(prm: np.ndarray, target: np.ndarray, g: np.ndarray) -> None:
     """Store the roll-independent parts of the roll equation of one target in g[3:9]."""
-    d0 = target[0, 3] - prm[F.C1]
-    d1 = target[1, 3] - prm[F.C1 + 1]
-    d2 = target[2, 3] - prm[F.C1 + 2]
-    dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
-    dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
-    rho = hypot(dp, dh)
+    d0, d1, d2 = from_yaw_axis(prm, target)
+    dp, dh, rho = across_yaw_axis(prm, d0, d1, d2)
     g[3, 0] = rho
     g[3, 1] = dp / rho if rho > 0.0 else 1.0
     g[3, 2] = dh / rho if rho > 0.0 else 0.0
@@ -169,20 +163,11 @@ def roll_mismatch(problem: RollProblem, theta: float) -> float:
 def lateral_miss(problem: RollProblem, theta: float) -> float:
     """By how much the tool point misses the yaw circle at roll theta [m] (0 within reach)."""
     prm, target, _, _, side, phi_ref, _ = problem
-    d0 = target[0, 3] - prm[F.C1]
-    d1 = target[1, 3] - prm[F.C1 + 1]
-    d2 = target[2, 3] - prm[F.C1 + 2]
-    dp = d0 * prm[F.P] + d1 * prm[F.P + 1] + d2 * prm[F.P + 2]
-    dh = d0 * prm[F.H] + d1 * prm[F.H + 1] + d2 * prm[F.H + 2]
-    rho = hypot(dp, dh)
+    d0, d1, d2 = from_yaw_axis(prm, target)
+    rho = across_yaw_axis(prm, d0, d1, d2)[2]
     if rho <= ROLL_DEGENERATE:
         return yaw(prm, d0, d1, d2, theta, side, phi_ref)[1]
-    lat: float = (
-        prm[F.LAM4]
-        + prm[F.W0 + 2]
-        + math.cos(theta) * prm[F.E1 + 2]
-        + math.sin(theta) * prm[F.E2 + 2]
-    )
+    lat = lateral_offset(prm, theta)
     if lat > rho:
         return lat - rho
     if -lat > rho:

@@ -29,7 +29,7 @@ from lynxplan.robots.ik.exact_roll_equation import (
     branch_reaches,
     exact_roll_equation,
 )
-from lynxplan.robots.ik.family_geometry import MODE_APPROACH, RollProblem
+from lynxplan.robots.ik.family_geometry import MODE_APPROACH, RollProblem, from_yaw_axis
 from lynxplan.robots.ik.roll_equation import (
     lateral_miss,
     roll_equation,
@@ -354,11 +354,7 @@ def exact_candidates(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled scan
     prm, target, g = problem[0], problem[1], problem[2]
     # the ideal and exact equations differ by up to ~6 deviations times d / rho (a position
     # error of the model turns the yaw by 1 / rho): measured on the SO-101
-    d0, d1, d2 = (
-        target[0, 3] - prm[F.C1],
-        target[1, 3] - prm[F.C1 + 1],
-        target[2, 3] - prm[F.C1 + 2],
-    )
+    d0, d1, d2 = from_yaw_axis(prm, target)
     d = math.sqrt(d0 * d0 + d1 * d1 + d2 * d2)
     band = EXACT_BAND * prm[F.DEVIATION] * (1.0 + d / max(g[3, 0], 1e-9))
     first = 0
