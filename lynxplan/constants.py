@@ -218,5 +218,9 @@ BRENT_RELATIVE, BRENT_ABSOLUTE = 1.5e-8, 1e-11
 NEAR_AXIS_MARGIN = 0.01
 #: Elbow cosines this close to +-1 are +-1 (a straight or folded elbow).
 FOLD_SNAP_TOLERANCE = 1e-14
+#: A model only close to the family, its elbow cosine within this of +-1 (near a fold): the
+#: closed form starts the two elbows at least FOLD_START_GAP [rad] apart, and Newton then finds
+#: each exact root (they are ~sqrt(deviation) apart) [1], [rad].
+FOLD_START_BAND, FOLD_START_GAP = 1e-6, 2e-3
 #: Translations beyond this, in [m], are out of reach before any arithmetic can overflow.
 FAR_AWAY = 1e9

@@ -17,7 +17,9 @@ from lynxplan.constants import (
     BLOCK_FOLD_BAND,
     BLOCK_OTHER_DEGENERATE,
     BLOCK_OTHER_MARGIN,
+    FOLD_START_BAND,
     REACH_MISS,
+    ROLL_DEGENERATE,
 )
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.ik.block_layout import (
@@ -83,7 +85,7 @@ def side_yaw(
     sine and cosine, the lateral miss [m], and whether the target is on the yaw axis (left to
     the scalar solver); alpha: the angle of the target about the yaw axis, its sine, cosine."""
     lat = pr[F.LAM4] + pr[F.W0 + 2] + ct * pr[F.E1 + 2] + st * pr[F.E2 + 2]
-    on_axis = (rho <= 1e-12) & (abs(lat) <= 1e-12)
+    on_axis = (rho <= ROLL_DEGENERATE) & (abs(lat) <= ROLL_DEGENERATE)
     ratio = lat / rho if rho > 0.0 else math.copysign(1.0, lat)
     miss = lat - rho if ratio > 1.0 else 0.0
     miss = -lat - rho if ratio < -1.0 else miss
@@ -266,7 +268,7 @@ def flip_geometry(
     reach = abs(la - lb) - dist if cosd < -1.0 else reach
     cosd = min(max(cosd, -1.0), 1.0)
     # where the scalar solver starts the two elbows apart (a near-family model): its result
-    fold_start = (pr[F.EXACT] == 0.0) & (abs(cosd) > 1.0 - 1e-6)
+    fold_start = (pr[F.EXACT] == 0.0) & (abs(cosd) > 1.0 - FOLD_START_BAND)
     fold = abs(cosd) > 1.0 - BLOCK_FOLD_BAND
     miss = math.sqrt(reach * reach + lat_miss * lat_miss)
     candidate = (ok0 | ok1) & (miss <= REACH_MISS)

@@ -19,6 +19,7 @@ import numba
 import numpy as np
 
 from lynxplan._jit import kernels_run_as_python
+from lynxplan.constants import FOLD_START_BAND, FOLD_START_GAP, ROLL_DEGENERATE
 from lynxplan.robots import family as F  # noqa: N812
 
 MODE_POSE, MODE_APPROACH, MODE_PITCH = 0, 1, 2
@@ -117,7 +118,8 @@ def yaw(
     """Canonical yaw angle phi of one side for roll theta, and the lateral miss [m]."""
     dp, dh, rho = across_yaw_axis(prm, d0, d1, d2)
     lat = lateral_offset(prm, theta)
-    if rho <= 1e-12 and abs(lat) <= 1e-12:  # on the yaw axis: any yaw; keep the reference
+    # on the yaw axis: any yaw; keep the reference
+    if rho <= ROLL_DEGENERATE and abs(lat) <= ROLL_DEGENERATE:
         return phi_ref + side * math.pi, 0.0
     ratio, miss = lat / rho if rho > 0 else math.copysign(1.0, lat), 0.0
     if ratio > 1.0:
@@ -208,7 +210,7 @@ def pitch_sum(
     if mode == MODE_PITCH:
         return pitch - 0.5 * math.pi - prm[F.GAMMA0], 0.0
     ah, ak, out = approach_in_plane(prm, a0, a1, a2, phi)
-    if hypot(ah, ak) <= 1e-12:  # approach along the pitch axis: any pitch is as good
+    if hypot(ah, ak) <= ROLL_DEGENERATE:  # approach along the pitch axis: any pitch is as good
         return ref_sum, out
     return math.atan2(ak, ah) - prm[F.GAMMA0], out
 
@@ -240,10 +242,9 @@ def two_link(prm: np.ndarray, x: float, y: float, elbow: int) -> tuple[float, fl
     elif cosd < -1.0:
         miss, cosd = abs(la - lb) - dist, -1.0
     delta = math.acos(cosd)
-    if prm[F.EXACT] == 0.0 and abs(cosd) > 1.0 - 1e-6:
-        # near a fold of a model that is only close to the family: start the two elbows apart,
-        # Newton then finds each exact root (they are ~sqrt(deviation) apart)
-        delta = max(delta, 2e-3) if cosd > 0 else min(delta, math.pi - 2e-3)
+    if prm[F.EXACT] == 0.0 and abs(cosd) > 1.0 - FOLD_START_BAND:
+        # near a fold of a model that is only close to the family: start the two elbows apart
+        delta = max(delta, FOLD_START_GAP) if cosd > 0 else min(delta, math.pi - FOLD_START_GAP)
     if elbow == 0:  # elbow up: the elbow lies above the shoulder-wrist line
         delta = -delta
     t2 = math.atan2(ry, rx) - math.atan2(lb * math.sin(delta), la + lb * math.cos(delta))

@@ -11,7 +11,12 @@ import numpy as np
 
 from lynxplan import _jit
 from lynxplan._arrays import kernel_input
-from lynxplan.constants import BRANCH_DUPLICATE_TOLERANCE, NEAR_AXIS_MARGIN, REACH_TOLERANCE
+from lynxplan.constants import (
+    BRANCH_DUPLICATE_TOLERANCE,
+    NEAR_AXIS_MARGIN,
+    POSE_EXACT,
+    REACH_TOLERANCE,
+)
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
 from lynxplan.robots.ik.elbow_labels import orient_elbows
@@ -182,7 +187,7 @@ def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -
     assert family is not None
     if family.exact or family.tool_on_roll_axis or target.kind == fk_.MODE_PITCH:
         return
-    exact_count = np.count_nonzero(valid & (oerr <= 1e-9), axis=1)
+    exact_count = np.count_nonzero(valid & (oerr <= POSE_EXACT), axis=1)
     if exact_count.all():  # every target has an exact branch: nothing to rescue
         return
     lower, upper = kinematics.lower.copy(), kinematics.upper.copy()
