@@ -18,7 +18,7 @@ from typing import Any
 import numba
 import numpy as np
 
-from lynxplan.planning.bounds import joint_poses, primitive_pose
+from lynxplan.planning.bounds import primitive_poses
 from lynxplan.planning.kernel_model import LANES, OBSTACLE_SPHERE, njit_no_refcount
 from lynxplan.planning.lanes import MAX_JOINTS, OUT_ARMS, OUT_S, OUT_SPHERE, spheres_along
 from lynxplan.planning.motion import (
@@ -114,9 +114,7 @@ def poses_at(q_a: np.ndarray, q_b: np.ndarray, s: float, model: Any, scratch: An
     q = scratch.q
     for j in range(q_a.shape[0]):
         q[j] = q_a[j] + s * (q_b[j] - q_a[j])
-    joint_poses(q, model, scratch)
-    for g in range(model.prim_joints.shape[0]):
-        primitive_pose(g, model, scratch)
+    primitive_poses(q, model, scratch)
 
 
 @njit_no_refcount()
