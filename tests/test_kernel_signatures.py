@@ -126,3 +126,44 @@ def test_each_big_kernel_has_one_compiled_signature() -> None:
         if any("Literal" in s for s in found) and name not in flagged
     }
     assert not repeated and not literal, (repeated, literal)
+
+
+# -- named kernel data --------------------------------------------------------------------------
+#: A compiled kernel takes at most this many parameters (issues 36, 37): what belongs together
+#: travels as one NamedTuple (or a tuple named in the docstring).
+MAX_KERNEL_PARAMETERS = 8
+_KERNEL_DECORATORS = ("njit", "jit", "njit_no_refcount", "njit_refcounted", "register_jitable")
+
+
+def _wide_kernels(source: str, filename: str) -> list[str]:
+    """``file:line name (count)`` of each compiled function of ``source`` with more than
+    MAX_KERNEL_PARAMETERS parameters."""
+    import ast
+
+    wide = []
+    for node in ast.walk(ast.parse(source)):
+        if not isinstance(node, ast.FunctionDef):
+            continue
+        names = [ast.unparse(d.func if isinstance(d, ast.Call) else d) for d in node.decorator_list]
+        if not any(name.rsplit(".", 1)[-1] in _KERNEL_DECORATORS for name in names):
+            continue
+        count = len(node.args.posonlyargs) + len(node.args.args) + len(node.args.kwonlyargs)
+        if count > MAX_KERNEL_PARAMETERS:
+            wide.append(f"{filename}:{node.lineno} {node.name} ({count})")
+    return wide
+
+
+def test_the_parameter_count_finds_a_wide_kernel() -> None:
+    source = (
+        "import numba\n@numba.njit(cache=True)\ndef k(a, b, c, d, e, f, g, h, i):\n    pass\n"
+        "@njit_no_refcount()\ndef ok(a, b, c, d, e, f, g, h):\n    pass\n"
+        "def plain(a, b, c, d, e, f, g, h, i):\n    pass\n"
+    )
+    assert _wide_kernels(source, "x.py") == ["x.py:3 k (9)"]
+
+
+def test_no_kernel_takes_more_than_eight_parameters() -> None:
+    wide = []
+    for path in sorted((ROOT / "lynxplan").rglob("*.py")):
+        wide += _wide_kernels(path.read_text(), str(path.relative_to(ROOT)))
+    assert not wide, wide

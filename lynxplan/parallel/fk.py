@@ -60,6 +60,19 @@ _SAMPLES = 16
 _NEWTON_STEPS = 3
 
 
+class ModeSlots(NamedTuple):
+    """:func:`fk_kernel`'s outputs for N solves, up to six assembly modes each."""
+
+    poses: np.ndarray
+    """(N, 6, 3) platform poses (xc, yc, alpha) [m, m, rad], sorted by alpha."""
+    modes: np.ndarray
+    """(N, 6) int64 working-mode index of each pose."""
+    errors: np.ndarray
+    """(N, 6) largest |IK(pose) - theta| of each pose [rad]."""
+    counts: np.ndarray
+    """(N,) int64 how many modes each solve has."""
+
+
 class ParallelFKResult(NamedTuple):
     """All real assembly modes for one set of actuated angles."""
 
@@ -252,9 +265,9 @@ def _insert_mode(
     mode: int,
     error: float,
     duplicate_tolerance: float,
-    out: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray],
+    out: ModeSlots,
 ) -> None:
-    """Add an assembly mode of solve n to ``out`` = (poses, modes, errors, counts), kept sorted by
+    """Add an assembly mode of solve n to ``out``, kept sorted by
     platform angle, unless a pose within ``duplicate_tolerance`` is already there."""
     poses, modes, errors, counts = out
     tol = duplicate_tolerance
@@ -281,17 +294,14 @@ def fk_kernel(
     theta: np.ndarray,
     legs: LegConstants,
     tolerances: np.ndarray,
-    poses: np.ndarray,
-    modes: np.ndarray,
-    errors: np.ndarray,
-    counts: np.ndarray,
+    out: ModeSlots,
 ) -> None:
     """Assembly modes of each solve n from its sextic ``coefficients[n]`` (7,), highest power
     first: roots on the unit circle -> centre from leg circles A and B -> Newton -> IK check ->
-    dedupe -> sort by alpha. Writes ``poses`` (N, 6, 3), ``modes`` (N, 6), ``errors`` (N, 6),
-    ``counts`` (N,); ``tolerances`` = (unit circle, IK verification, duplicate)."""
+    dedupe -> sort by alpha, into ``out`` (every solve's count; the modes it counts);
+    ``tolerances`` = (unit circle, IK verification, duplicate)."""
     pose = np.empty(3)
-    out = (poses, modes, errors, counts)
+    counts = out.counts
     for n in range(coefficients.shape[0]):
         counts[n] = 0
         for z in _sextic_roots(coefficients[n]):
@@ -344,10 +354,7 @@ def solve_fk_batch(
         np.ascontiguousarray(thetas),
         leg_constants(geometry),
         tolerances,
-        poses,
-        modes,
-        errors,
-        counts,
+        ModeSlots(poses, modes, errors, counts),
     )
     return [
         ParallelFKResult(poses[n, : counts[n]], modes[n, : counts[n]], errors[n, : counts[n]])

@@ -37,15 +37,16 @@ def reach_kernel(
     x: np.ndarray,
     y: np.ndarray,
     alphas: np.ndarray,
-    base: np.ndarray,
-    phase: np.ndarray,
-    rp: float,
-    lo: float,
-    hi: float,
+    platform: tuple[np.ndarray, np.ndarray, float],
+    leg_reach: tuple[float, float],
     out: np.ndarray,
 ) -> None:
     """``out[k, i, j]`` = every leg reaches at centre ``(x[j], y[i])`` and orientation
-    ``alphas[k]``; ``out`` has shape (K, ny, nx)."""
+    ``alphas[k]``; ``out`` has shape (K, ny, nx). ``platform`` = (base, phase, rp): the base
+    anchors, the platform anchors' phases and circumradius (``kernel_constants``, [m], [rad],
+    [m]); ``leg_reach`` = (lo, hi): the annulus a leg's platform anchor reaches [m]."""
+    base, phase, rp = platform
+    lo, hi = leg_reach
     lo2, hi2 = lo * lo, hi * hi
     nx = x.shape[0]
     dx2 = np.empty((3, nx))
@@ -186,16 +187,12 @@ def reachable_stack(
         raise NonFiniteInputError("alphas")
     base, phase = kernel_constants(geometry)
     out = np.empty((alphas.size, len(y), len(x)), dtype=np.bool_)
-    lo, hi = geometry.leg_reach
     reach_kernel(
         np.ascontiguousarray(x, dtype=float),
         np.ascontiguousarray(y, dtype=float),
         alphas,
-        base,
-        phase,
-        geometry.platform_circumradius,
-        lo,
-        hi,
+        (base, phase, geometry.platform_circumradius),
+        geometry.leg_reach,
         out,
     )
     return out

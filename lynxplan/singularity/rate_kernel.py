@@ -213,11 +213,11 @@ def _tr_command(
     m: float,
     xc: np.ndarray,
     settings: RateSettings,
-    dE: np.ndarray,
-    grad: np.ndarray,
+    work: tuple[np.ndarray, np.ndarray],
 ) -> tuple[np.ndarray, float]:
-    """Task reconstruction: the reconstructed command ``xdot_p`` and ``k1(m)``; ``dE`` (8, 5, 5)
-    and ``grad`` (5,) are work arrays."""
+    """Task reconstruction: the reconstructed command ``xdot_p`` and ``k1(m)``; ``work`` =
+    (dE (8, 5, 5), grad (5,)) are work arrays."""
+    dE, grad = work
     k = rows.shape[0]
     extended_jacobian_derivative_kernel(q, arm[0], arm[1], arm[2], dE)
     # gradient of m: m tr(J^+ dJ_j)
@@ -245,13 +245,14 @@ def _joint_rate(
     rows: np.ndarray,
     J: np.ndarray,
     m: float,
-    e: np.ndarray,
-    ff: np.ndarray,
+    task_error: tuple[np.ndarray, np.ndarray],
     settings: RateSettings,
-    dE: np.ndarray,
-    grad: np.ndarray,
+    work: tuple[np.ndarray, np.ndarray],
 ) -> tuple[np.ndarray, float, float]:
-    """Step 2: the strategy's joint rate ``qd`` (5,), ``k1`` and the path-clock rate."""
+    """Step 2: the strategy's joint rate ``qd`` (5,), ``k1`` and the path-clock rate from the
+    task error and feed-forward rate ``task_error`` = (e, ff) (k,) each; ``work`` as in
+    ``_tr_command``."""
+    e, ff = task_error
     gain = settings.gain
     if settings.strategy == _DLS:
         return _dls_rate(J, ff + gain * e, m, settings), 0.0, 1.0
@@ -262,7 +263,7 @@ def _joint_rate(
         rate = _speed_scale(qa, qb, settings.vmax)
         return rate * qa + qb, 0.0, rate
     if settings.strategy == _TR:
-        xc, k1 = _tr_command(q, arm, rows, Jp, m, ff + gain * e, settings, dE, grad)
+        xc, k1 = _tr_command(q, arm, rows, Jp, m, ff + gain * e, settings, work)
         return Jp @ xc, k1, 1.0
     return Jp @ (ff + gain * e), 0.0, 1.0
 
@@ -305,7 +306,7 @@ def resolved_rate_kernel(
             e[i] = xr[columns[i]] - x[columns[i]]
             ff[i] = xrd[columns[i]]
         m = manipulability_kernel(J)
-        qd, k1, rate = _joint_rate(q, arm, rows, J, m, e, ff, settings, dE, grad)
+        qd, k1, rate = _joint_rate(q, arm, rows, J, m, (e, ff), settings, (dE, grad))
         out.t[n] = t
         out.path_time[n] = tau
         out.q[n] = q
