@@ -12,6 +12,12 @@ ACOS_CLAMP_TOLERANCE = 1e-9
 
 #: Tool point this close to the base axis is treated as on it, in [m].
 BASE_AXIS_TOLERANCE = 1e-9
+#: An approach whose horizontal part is shorter than this [1] does not lean: on the base axis
+#: the base angle then keeps its reference (the AL5's closed form).
+APPROACH_LEANS = 1e-9
+#: Below this rotation angle [rad] the rotation error is its series asin(x) = x + x^3 / 6
+#: (exact to ~1e-21 rad; the AL5's closed form).
+SMALL_ROTATION_SERIES = 1e-4
 
 #: Default accepted orientation residual for strict IK, in [rad].
 STRICT_ORIENTATION_TOLERANCE = 1e-6
@@ -122,6 +128,13 @@ NUMERICAL_POSITION_TOLERANCE = 1e-10
 
 #: ... and the target orientation (or approach axis) within this [rad].
 NUMERICAL_ORIENTATION_TOLERANCE = 1e-9
+#: Levenberg-Marquardt stops iterating when the pose error's norm falls below this [m, rad].
+NUMERICAL_CONVERGED = 1e-13
+#: The near-axis rescue starts the numerical solver only where a branch came this close to the
+#: target position [m] (a polish that failed near a double root).
+RESCUE_NEAR_MISS = 1e-4
+#: ``Robot.ik(verify=True)``: Pinocchio's FK and the solver's agree to this [m].
+PINOCCHIO_AGREEMENT = 1e-12
 
 #: A local extremum of the roll equation this close to zero is a double root (f is the sine of
 #: a roll mismatch or an axis component: 1e-10 means 1e-10 rad).
@@ -212,6 +225,9 @@ EXACT_BAND = 16.0
 ROOT_MERGE = 1e-6
 #: Brent's minimisation: relative and absolute tolerance on the minimiser [rad].
 BRENT_RELATIVE, BRENT_ABSOLUTE = 1.5e-8, 1e-11
+#: The Illinois refinement of a root stops when its bracket is narrower than this [rad], or
+#: than ROOT_BRACKET_RELATIVE times (1 + |root|) (a few units in the last place).
+ROOT_BRACKET, ROOT_BRACKET_RELATIVE = 1e-15, 4e-16
 #: Targets this much closer to the yaw axis than the wrist's lateral offset plus the tool's
 #: off-axis distance are "near the axis" [m]: there the yaw is so sensitive that a model only
 #: close to the family (SO-101) can hide a root of the exact model from the ideal one.

@@ -185,6 +185,20 @@ def test_every_ik_tolerance_is_named_once_in_lynxplan_constants():
         if isinstance(target, ast.Name) and "TOLERANCE" in target.id
     }
     assert not own, sorted(own)
+    # nor a tolerance written as a number in a test of the solvers (underflow guards aside)
+    solvers = [*(PACKAGE / "robots" / "ik").glob("*.py"), *(PACKAGE / "arm").glob("ik*.py")]
+    literal = [
+        f"{path.relative_to(PACKAGE)}:{node.lineno} {ast.unparse(node)}"
+        for path in solvers
+        for node in ast.walk(ast.parse(path.read_text(encoding="utf-8")))
+        if isinstance(node, ast.Compare)
+        for value in ast.walk(node)
+        if isinstance(value, ast.Constant)
+        and isinstance(value.value, float)
+        and 1e-100 < abs(value.value) < 1e-3
+    ]
+    assert len(solvers) >= 20
+    assert not literal, literal
     from lynxplan import constants
 
     assert constants.REACH_TOLERANCE == 1e-9  # a computed branch reaches its target

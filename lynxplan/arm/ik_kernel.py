@@ -15,10 +15,13 @@ import numpy as np
 
 from lynxplan._fastmath import atan2, sincos
 from lynxplan.constants import (
+    APPROACH_LEANS,
     BASE_AXIS_TOLERANCE,
     FAR_AWAY,
     FOLD_SNAP_TOLERANCE,
     RIGIDITY_REPAIR_TOLERANCE,
+    ROLL_DEGENERATE,
+    SMALL_ROTATION_SERIES,
     WRIST_SNAP_TOLERANCE,
 )
 from lynxplan.robots.ik.family_geometry import wrap_into_limits
@@ -121,7 +124,7 @@ def _angle_of_matrix(m: tuple[float, ...]) -> float:
     sine = math.sqrt(sx * sx + sy * sy + sz * sz)
     cosine = 0.5 * (m00 + m11 + m22 - 1.0)
     # Reachable targets are small angles: asin(x) = x + x^3/6 + O(x^5), exact to ~1e-21 rad.
-    small = (sine < 1e-4) & (cosine > 0.0)
+    small = (sine < SMALL_ROTATION_SERIES) & (cosine > 0.0)
     return sine + sine * sine * sine / 6.0 if small else atan2(sine, cosine)
 
 
@@ -249,7 +252,7 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         rho = math.sqrt(px * px + py * py)
         horizontal = math.sqrt(ax * ax + ay * ay)
         s_ref, c_ref = sincos(s[_Q1_REF, i])
-        leans = horizontal > 1e-9
+        leans = horizontal > APPROACH_LEANS
         c1 = ax / horizontal if leans else c_ref
         s1 = ay / horizontal if leans else s_ref
         off_axis = rho > BASE_AXIS_TOLERANCE_K
@@ -259,7 +262,7 @@ def _solve_block(  # noqa: PLR0915 (one vectorised pass: every step is a select)
         c234 = -az
         norm = math.sqrt(s234 * s234 + c234 * c234)
         s_pitch, c_pitch = sincos(s[_PITCH_REF, i])
-        normal = norm < 1e-12  # approach normal to the arm plane: any pitch is as good
+        normal = norm < ROLL_DEGENERATE  # approach normal to the arm plane: any pitch is as good
         s234 = s_pitch if normal else s234 / norm
         c234 = c_pitch if normal else c234 / norm
         # Step 3: the wrist centre in plane coordinates (radial r, height z), the reach miss.

@@ -22,6 +22,7 @@ import numpy as np
 from lynxplan._arrays import kernel_input
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
+    PINOCCHIO_AGREEMENT,
     REACH_TOLERANCE,
 )
 from lynxplan.exceptions import ShapeError, TargetError
@@ -338,7 +339,7 @@ class Robot:
         """``result``, once Pinocchio's FK of each branch agrees with the solver's own FK.
 
         Raises:
-            IkFailedError: a branch where they disagree by more than 1e-12 m.
+            IkFailedError: a branch where they disagree by more than PINOCCHIO_AGREEMENT (1e-12 m).
         """
         from lynxplan.exceptions import IkFailedError
 
@@ -347,7 +348,7 @@ class Robot:
             placement = self.frame_placement(s.q)
             own = self.fk(s.q)
             gap = float(np.abs(placement[:3] - own[:3]).max())
-            if gap > 1e-12:
+            if gap > PINOCCHIO_AGREEMENT:
                 raise IkFailedError(s.position_error, f"Pinocchio FK disagrees by {gap:.3g} m")
         return result
 

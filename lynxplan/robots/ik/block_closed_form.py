@@ -62,7 +62,7 @@ def pitch_sum(
         atan2(a_k, x) - shape[6],
         sx * cg - cx * sg,
         cx * cg + sx * sg,
-        x * x + a_k * a_k <= 1e-24,
+        x * x + a_k * a_k <= ROLL_DEGENERATE * ROLL_DEGENERATE,
     )
 
 

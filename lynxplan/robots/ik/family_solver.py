@@ -16,6 +16,7 @@ from lynxplan.constants import (
     NEAR_AXIS_MARGIN,
     POSE_EXACT,
     REACH_TOLERANCE,
+    RESCUE_NEAR_MISS,
 )
 from lynxplan.robots.ik import family_kernel as fk_
 from lynxplan.robots.ik import pose_kernel as _pk
@@ -196,14 +197,14 @@ def rescue_near_axis(kinematics: Kinematics, target: Target, out: BranchSlots) -
         # near-double roots of the approach equation split differently on the exact model:
         # with no exact branch found, look next to the branches along the roll
         # (also when no branch reaches the position: the polish failed on every one)
-        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
+        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= RESCUE_NEAR_MISS
         rows = np.flatnonzero(near_miss & np.isnan(target.roll) & (exact_count == 0))
     else:
         k = np.array(family.yaw_axis)
         d = target.poses[:, :3, 3] - family.packed[0:3]
         rho = np.linalg.norm(d - np.outer(d @ k, k), axis=1)
         near = rho < abs(family.lateral_offset) + family.tool_offset[1] + NEAR_AXIS_MARGIN
-        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= 1e-4
+        near_miss = np.where(valid, perr, np.inf).min(axis=1) <= RESCUE_NEAR_MISS
         rows = np.flatnonzero(near & near_miss & (exact_count == 0))
     axis = np.array(family.approach_in_tool)
     chain = kinematics.chain

@@ -16,6 +16,7 @@ import numba
 import numpy as np
 
 from lynxplan.constants import (
+    NUMERICAL_CONVERGED,
     NUMERICAL_ORIENTATION_TOLERANCE,
     NUMERICAL_POSITION_TOLERANCE,
 )
@@ -190,7 +191,7 @@ def numerical_ik_kernel(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled l
             cost = _linearised(arm, q, target, approach_only, frames, e)
             for _ in range(MAX_ITERATIONS):
                 total += 1
-                if cost < 1e-26:
+                if cost < NUMERICAL_CONVERGED * NUMERICAL_CONVERGED:
                     break
                 for i in range(n):
                     b[i] = 0.0

@@ -12,7 +12,13 @@ import numba
 import numpy as np
 from numba.extending import overload
 
-from lynxplan.constants import BRENT_ABSOLUTE, BRENT_RELATIVE, EXACT_ROOT_STEP
+from lynxplan.constants import (
+    BRENT_ABSOLUTE,
+    BRENT_RELATIVE,
+    EXACT_ROOT_STEP,
+    ROOT_BRACKET,
+    ROOT_BRACKET_RELATIVE,
+)
 from lynxplan.robots.ik.exact_roll_equation import ExactProblem, exact_roll_equation
 from lynxplan.robots.ik.family_geometry import RollProblem
 from lynxplan.robots.ik.roll_equation import roll_equation
@@ -61,7 +67,7 @@ def refine_root(
         if not (min(a, b) <= c <= max(a, b)):
             c = 0.5 * (a + b)
         fc = equation(problem, c)
-        if fc == 0.0 or abs(b - a) < 1e-15 or abs(c - previous) < xtol:
+        if fc == 0.0 or abs(b - a) < ROOT_BRACKET or abs(c - previous) < xtol:
             return c
         previous = c
         if (fc > 0) == (fb > 0):
@@ -74,7 +80,7 @@ def refine_root(
             if side_kept == 1:
                 fb *= 0.5
             side_kept = 1
-        if abs(b - a) < 4e-16 * (1.0 + abs(c)):
+        if abs(b - a) < ROOT_BRACKET_RELATIVE * (1.0 + abs(c)):
             return c
     return (a * fb - b * fa) / (fb - fa)
 
