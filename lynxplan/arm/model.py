@@ -177,6 +177,9 @@ class Arm:
         return int(self.model.getFrameId(frame))
 
     # -- inverse kinematics -----------------------------------------------------------------------
+    #: The branch-selection rules ``ik`` offers (as ``Robot.selection_rules``).
+    selection_rules = ("nearest", "report")
+
     def ik_batch(
         self,
         T: np.ndarray,

@@ -65,7 +65,8 @@ def register(subparsers: Any) -> None:
         "--select",
         choices=("nearest", "report"),
         default="nearest",
-        help="nearest to --reference (default), or the report's rule q2 >= 0, q3 <= 0",
+        help="nearest to --reference (default), or the report's rule q2 >= 0, q3 <= 0 (the AL5"
+        " only)",
     )
     ik.add_argument("--reference", help="reference configuration, JSON list of 5 angles")
     _add_unit_options(ik)

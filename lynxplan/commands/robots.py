@@ -228,9 +228,11 @@ def handle_robot_ik(args: argparse.Namespace) -> int:
             roll=roll,
             q_reference=reference,
             verify=True,
+            select=args.select,
         )
     elif args.pose is not None:
-        result = robot.ik(parse_pose(args.pose, unit_length), q_reference=reference, verify=True)
+        pose = parse_pose(args.pose, unit_length)
+        result = robot.ik(pose, q_reference=reference, verify=True, select=args.select)
     else:
         raise InputError(
             "ik: the following arguments are required: --pose"

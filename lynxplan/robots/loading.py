@@ -41,6 +41,8 @@ class BuiltinRobot:
         arm_joints: Joints of its arm chain (the gripper's locked joints not counted).
         srdf: Its SRDF (the self-collision pairs it disables) where :func:`find_srdf` would not
             find it by the URDF's name; None: found by name, or none.
+        selection_rules: The IK branch-selection rules it offers (``Robot.ik``'s ``select``):
+            "nearest" for every robot, the AL5 also the report's "report".
     """
 
     name: str
@@ -50,6 +52,7 @@ class BuiltinRobot:
     package_dirs: tuple[str, ...]
     arm_joints: int = 5
     srdf: Path | None = None
+    selection_rules: tuple[str, ...] = ("nearest",)
 
 
 def _example_robot_data_dir() -> Path:
@@ -74,6 +77,7 @@ def builtin_robots() -> dict[str, BuiltinRobot]:
             default_urdf_path(),
             "tool",
             (),
+            selection_rules=("nearest", "report"),
         ),
         "so100": BuiltinRobot(
             "so100",

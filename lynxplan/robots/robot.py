@@ -42,6 +42,9 @@ from lynxplan.robots.results import (
     TrackResult,
 )
 from lynxplan.robots.selection import (
+    NEAREST,
+    REPORT,
+    by_report_rule,
     select_one,
 )
 from lynxplan.robots.targets import (
@@ -96,6 +99,9 @@ class Robot:
         self.disabled_collisions = loaded.disabled_collisions
         self._urdf_xml = loaded.urdf_xml
         self.builtin = builtin
+        #: The branch-selection rules ``ik`` offers (``select``): "nearest"; the AL5 also
+        #: "report" (SPEC Part 1's rule).
+        self.selection_rules = builtin.selection_rules if builtin is not None else (NEAREST,)
         self.nq = int(self.model.nq)
         position = np.column_stack((self.model.lowerPositionLimit, self.model.upperPositionLimit))
         velocity = np.array(self.model.velocityLimit, dtype=float)
@@ -289,19 +295,22 @@ class Robot:
             approach_only: ``lynxplan.arm.Arm.ik`` compatibility: ``pose`` is a position (column
                 3) and an approach direction (column 2); the roll is ``roll``, else the roll of
                 ``q_reference`` (else free).
-            select: ``"nearest"`` (the only rule for every robot; the AL5's ``"report"`` rule
-                lives in ``lynxplan.arm``).
+            select: ``"nearest"`` (every robot: within the limits, nearest ``q_reference``) or
+                a rule of the robot's own (``selection_rules``): the AL5's ``"report"``, the
+                first branch within the limits with q2 >= 0 and q3 <= 0.
             verify: Also re-check each branch with Pinocchio's FK (adds ~5 us per branch). Every
                 branch is always verified by the solver's FK of the exact chain (the same
                 product of exponentials; equal to Pinocchio's to 1e-15 m in the tests).
 
         Raises:
-            ShapeError, NonFiniteInputError, TargetError: malformed target.
+            ShapeError, NonFiniteInputError, TargetError: malformed target, or a ``select``
+                rule the robot does not offer.
         """
         if pose is not None and np.shape(pose) != (4, 4):
             raise ShapeError("pose", "(4, 4)", np.shape(pose))
-        if select != "nearest":
-            raise TargetError(f"select must be 'nearest' for a Robot. Got: {select!r}")
+        if select not in self.selection_rules:
+            rules = ", ".join(repr(r) for r in self.selection_rules)
+            raise TargetError(f"select: {self.name} offers {rules}. Got: {select!r:.40}")
         if (
             pose is not None
             and position is None
@@ -314,7 +323,7 @@ class Robot:
             # the lean paths; a pose they cannot solve (NaN/inf, out of reach) goes on below
             one = dispatch.solve_pose_one(self.kinematics, pose, self._reference(q_reference, 1)[0])
             if one is not None:
-                return self._verified(one) if verify else one
+                return self._finished(one, select, verify)
         if approach_only:
             if pose is None:
                 raise TargetError("approach_only needs a pose (position and approach columns)")
@@ -333,6 +342,13 @@ class Robot:
         result = select_one(
             dispatch.solve(self.kinematics, target, reference), reference[0], self.ik_solver
         )
+        return self._finished(result, select, verify)
+
+    def _finished(self, result: RobotIkResult, select: str, verify: bool) -> RobotIkResult:
+        """``result`` selected by the rule ``select`` (it comes selected by "nearest"),
+        verified by Pinocchio's FK where ``verify``."""
+        if select == REPORT:
+            result = by_report_rule(result)
         return self._verified(result) if verify else result
 
     def _verified(self, result: RobotIkResult) -> RobotIkResult:

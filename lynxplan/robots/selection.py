@@ -1,14 +1,38 @@
 """Choosing among IK branches: the one nearest a reference for one target (along a track:
-:mod:`lynxplan.robots.tracking`)."""
+:mod:`lynxplan.robots.tracking`), or a robot's own rule (:data:`REPORT`, the AL5's)."""
 
 from __future__ import annotations
 
+import dataclasses
 import math
 
 import numpy as np
 
 from lynxplan.constants import REACH_TOLERANCE
 from lynxplan.robots.results import RobotIkBatch, RobotIkResult, RobotIkSolution
+
+#: The selection rules: the branch nearest the reference (every robot), and the report's rule
+#: (SPEC Part 1, the AL5's): the first branch, in slot order, with q2 >= 0 and q3 <= 0.
+NEAREST, REPORT = "nearest", "report"
+
+
+def by_report_rule(result: RobotIkResult) -> RobotIkResult:
+    """``result`` with the branch the report's rule selects: the first, in slot order, within
+    the limits that reaches the target with q2 >= 0 [rad] and q3 <= 0 [rad]; None when no
+    branch qualifies (the orientation residual is then the best branch's)."""
+    limit = result.distance + REACH_TOLERANCE
+    chosen = next(
+        (
+            i
+            for i, s in enumerate(result.solutions)
+            if s.within_limits and s.position_error <= limit and s.q[1] >= 0.0 and s.q[2] <= 0.0
+        ),
+        None,
+    )
+    errors = [s.orientation_error for s in result.solutions]
+    ranked = chosen if chosen is not None else (int(np.argmin(errors)) if errors else None)
+    residual = float(errors[ranked]) if ranked is not None else np.nan
+    return dataclasses.replace(result, selected=chosen, orientation_residual=residual)
 
 
 def select_one(batch: RobotIkBatch, reference: np.ndarray, solver: str) -> RobotIkResult:

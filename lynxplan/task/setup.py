@@ -227,10 +227,9 @@ def _waypoint(
     else:
         pose = _approach_pose(np.array(entry.position) * length, np.array(entry.approach))
         key = "position"
-    # The AL5 has the report's branch rule; a URDF robot takes the branch nearest q_reference.
-    from lynxplan.arm.model import Arm
-
-    report_rule = entry.ik == "report" and isinstance(arm, Arm)
+    # The AL5 (its package or its Robot) has the report's branch rule; any other robot takes
+    # the branch nearest q_reference.
+    report_rule = entry.ik == "report" and "report" in arm.selection_rules
     try:
         result = arm.ik(
             pose,
