@@ -7,6 +7,7 @@ Shared by the AL5's results (:mod:`lynxplan.arm.ik_result`) and every Robot's
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import NamedTuple, Protocol
 
 import numpy as np
@@ -55,3 +56,38 @@ class IkSolution(NamedTuple):
     within_limits: bool
     position_error: float
     orientation_error: float
+
+
+@dataclass(frozen=True)
+class IkResult:
+    """IK of one target: every branch found, each verified; one selected (the AL5's
+    ``Arm.ik`` and every ``Robot.ik``; ``lynxplan.robots.RobotIkResult`` is this type).
+
+    Attributes:
+        solutions: The branches (verified by FK), solver order (the AL5's: four, in
+            ``lynxplan.arm.ik.BRANCH_NAMES`` order).
+        selected: Index of the chosen one (within limits and reachable, by the selection rule),
+            or None when no branch is within the limits.
+        reachable: Whether the target position is reached (position error within tolerance).
+        distance: Smallest position error over the branches, in [m] (0 up to rounding when
+            reachable): how far the nearest reachable solution is from the target.
+        orientation_residual: Orientation error of the selected (else best) branch, in [rad].
+        solver: ``"AL5 closed form"``, ``"yaw-pitch3-roll closed form"``, ``"... + roll root
+            search"``, ``"numerical"``.
+    """
+
+    solutions: tuple[IkSolution, ...]
+    selected: int | None
+    reachable: bool
+    distance: float
+    orientation_residual: float
+    solver: str
+
+    @property
+    def q(self) -> np.ndarray:
+        """The selected solution, shape (n,), in [rad].
+
+        Raises:
+            NoSolutionWithinLimitsError: if no branch is within the joint limits.
+        """
+        return selected_q(self.solutions, self.selected)

@@ -17,7 +17,7 @@ from lynxplan import guards
 from lynxplan._arrays import kernel_input
 from lynxplan.arm.configuration import as_configurations
 from lynxplan.arm.geometry import TOOL_FRAME
-from lynxplan.arm.ik_result import IkResult, IkSolution
+from lynxplan.arm.ik_result import SOLVER, IkResult, IkSolution
 from lynxplan.arm.urdf import native_stderr_captured, read_geometry, read_limits
 from lynxplan.constants import (
     LIMIT_SNAP_TOLERANCE,
@@ -285,7 +285,14 @@ class Arm:
             IkSolution(q[2], names[2], values[2][0] > 0.5, values[2][1], values[2][2]),
             IkSolution(q[3], names[3], values[3][0] > 0.5, values[3][1], values[3][2]),
         )
-        return IkResult(solutions, None if selected < 0 else int(selected), residual)
+        return IkResult(
+            solutions,
+            None if selected < 0 else int(selected),
+            reachable=True,  # else UnreachablePoseError above
+            distance=min(row[1] for row in values),
+            orientation_residual=residual,
+            solver=SOLVER,
+        )
 
 
 def _raise_for_status(status: int, miss: float, deviation: float) -> None:

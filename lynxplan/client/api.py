@@ -61,8 +61,8 @@ class Client(Transport):
         approach_only: bool = False,
         robot: str = "al5",
     ) -> Any:
-        """IK, as the library: a (4, 4) pose gives :class:`~lynxplan.arm.model.IkResult`
-        (:meth:`Arm.ik`), (N, 4, 4) poses an :class:`~lynxplan.arm.ik.IkBatch`
+        """IK, as the library: a (4, 4) pose gives :class:`~lynxplan.branches.IkResult`
+        (:meth:`Arm.ik`, :meth:`Robot.ik`), (N, 4, 4) poses an :class:`~lynxplan.arm.ik.IkBatch`
         (:meth:`Arm.ik_batch`)."""
         T = np.asarray(T, dtype=float)
         if T.ndim == 3:

@@ -79,8 +79,8 @@ def _number(value: Any) -> Any:
 
 
 def ik_result(fields: Mapping[str, Any]) -> Any:
-    """An :class:`~lynxplan.arm.model.IkResult` from a single-pose ``/ik`` answer."""
-    from lynxplan.arm.model import IkResult, IkSolution
+    """The :class:`~lynxplan.branches.IkResult` of a single-pose ``/ik`` answer."""
+    from lynxplan.branches import IkResult, IkSolution
 
     solutions = tuple(
         IkSolution(
@@ -92,7 +92,14 @@ def ik_result(fields: Mapping[str, Any]) -> Any:
         )
         for s in fields["solutions"]
     )
-    return IkResult(solutions, fields["selected"], fields["orientation_residual"])
+    return IkResult(
+        solutions,
+        fields["selected"],
+        fields["reachable"],
+        fields["distance"],
+        fields["orientation_residual"],
+        fields["solver"],
+    )
 
 
 def obstacle_json(obstacle: Any) -> dict[str, Any]:

@@ -25,35 +25,12 @@ from __future__ import annotations
 import math
 import sys
 from collections.abc import Sequence
-from typing import Any, NamedTuple, Protocol
+from typing import Any, NamedTuple
 
 import numpy as np
 
+from lynxplan.branches import IkResult
 from lynxplan.units import angle_factor, length_factor
-
-
-class _IkBranch(Protocol):
-    """What an IK answer reads of one branch (arm and URDF-robot results alike)."""
-
-    @property
-    def q(self) -> np.ndarray: ...
-    @property
-    def branch(self) -> str: ...
-    @property
-    def within_limits(self) -> bool: ...
-    @property
-    def orientation_error(self) -> float: ...
-    @property
-    def position_error(self) -> float: ...
-
-
-class _IkResult(Protocol):
-    """What an IK answer reads of a result."""
-
-    @property
-    def solutions(self) -> Sequence[_IkBranch]: ...
-    @property
-    def selected(self) -> int | None: ...
 
 
 class JointTable(NamedTuple):
@@ -113,7 +90,7 @@ def _excess(q: np.ndarray, joints: JointTable) -> float:
 
 
 def ik_answer(
-    result: _IkResult,
+    result: IkResult,
     joints: JointTable,
     units: Units,
     *,
@@ -170,7 +147,7 @@ def ik_answer(
     }
 
 
-def _nearest(result: _IkResult, listed: list[int], joints: JointTable) -> int | None:
+def _nearest(result: IkResult, listed: list[int], joints: JointTable) -> int | None:
     """Row index of the branch that comes nearest: the result's pick (within the limits,
     nearest the target), else the listed branch breaking the limits least."""
     if not listed:

@@ -65,8 +65,8 @@ def register(subparsers: Any) -> None:
         "--select",
         choices=("nearest", "report"),
         default="nearest",
-        help="nearest to --reference (default), or the report's rule q2 >= 0, q3 <= 0 (the AL5"
-        " only)",
+        help="nearest to --reference (default), or the report's rule q2 >= 0, q3 <= 0 (the AL5:"
+        " the default arm or --robot al5)",
     )
     ik.add_argument("--reference", help="reference configuration, JSON list of 5 angles")
     _add_unit_options(ik)
@@ -119,7 +119,7 @@ def handle_ik(args: argparse.Namespace) -> int:
     """Print every IK branch of a pose and the selected one."""
     from lynxplan.arm import load_arm
     from lynxplan.arm.geometry import JOINT_NAMES
-    from lynxplan.arm.ik_result import IkResult
+    from lynxplan.arm.ik_result import SOLVER, IkResult
 
     if args.poses is not None:
         return _ik_batch.handle(args)
@@ -149,7 +149,8 @@ def handle_ik(args: argparse.Namespace) -> int:
     except UnreachablePoseError as exc:
         if args.strict:
             raise
-        result, reachable, distance = IkResult((), None, float("nan")), False, exc.distance
+        result = IkResult((), None, False, exc.distance, float("nan"), SOLVER)
+        reachable, distance = False, exc.distance
     else:
         reachable, distance = True, 0.0
     answer = _ik.ik_answer(

@@ -7,43 +7,15 @@ from typing import NamedTuple
 
 import numpy as np
 
-from lynxplan.branches import IkSolution, selected_q
+from lynxplan.branches import IkResult, IkSolution
 
 #: One IK branch of any robot, verified by FK on the exact model: the AL5's branch type (one
 #: type for both; its ``q`` has shape (n,) here).
 RobotIkSolution = IkSolution
 
 
-@dataclass(frozen=True)
-class RobotIkResult:
-    """IK of one target: every branch found, each verified; one selected.
-
-    Attributes:
-        solutions: The branches (verified by FK), solver order.
-        selected: Index of the chosen one (within limits and reachable, nearest to the
-            reference), or None when no branch is within the limits.
-        reachable: Whether the target position is reached (position error within tolerance).
-        distance: Smallest position error over the branches, in [m] (0 up to rounding when
-            reachable): how far the nearest reachable solution is from the target.
-        orientation_residual: Orientation error of the selected (else best) branch, in [rad].
-        solver: ``"yaw-pitch3-roll closed form"``, ``"... + roll root search"``, ``"numerical"``.
-    """
-
-    solutions: tuple[RobotIkSolution, ...]
-    selected: int | None
-    reachable: bool
-    distance: float
-    orientation_residual: float
-    solver: str
-
-    @property
-    def q(self) -> np.ndarray:
-        """The selected solution, shape (n,), in [rad].
-
-        Raises:
-            NoSolutionWithinLimitsError: if no branch is within the joint limits.
-        """
-        return selected_q(self.solutions, self.selected)
+#: IK of one target (every branch, one selected): the one result type of every arm.
+RobotIkResult = IkResult
 
 
 class BranchSlots(NamedTuple):

@@ -286,7 +286,7 @@ class Robot:
         approach_only: bool = False,
         select: str = "nearest",
     ) -> RobotIkResult:
-        """IK of one target: every branch, verified, one selected (nearest the reference).
+        """IK of one target: every branch, verified, one selected (by ``select``).
 
         Args:
             pose: Target tool pose, shape (4, 4), [m]; or ``position`` (3,) [m] with

@@ -18,8 +18,11 @@ NEAREST, REPORT = "nearest", "report"
 
 def by_report_rule(result: RobotIkResult) -> RobotIkResult:
     """``result`` with the branch the report's rule selects: the first, in slot order, within
-    the limits that reaches the target with q2 >= 0 [rad] and q3 <= 0 [rad]; None when no
-    branch qualifies (the orientation residual is then the best branch's)."""
+    the limits with q2 >= 0 [rad] and q3 <= 0 [rad] among those that reach the target (or, out
+    of reach, come nearest); None when no branch qualifies (the orientation residual is then
+    the best branch's). On the shipped AL5's limits (q2 in [0, 150] deg, q3 in [-150, 0] deg)
+    the sign test always holds and at most one branch of a pose lies within the limits: the
+    rule then selects what "nearest" selects."""
     limit = result.distance + REACH_TOLERANCE
     chosen = next(
         (

@@ -106,7 +106,7 @@ def add_kinematics_routes(
                                     "approach_only": only_approach, "verify": verify,
                                     "answer": answer}  # fmt: skip
         else:
-            select = inputs.choice(body, "select", ("nearest", "report"))
+            select = inputs.choice(body, "select", arm.selection_rules)
             task = {"robot": name, "T": T, "reference": reference, "select": select,
                     "approach_only": only_approach}  # fmt: skip
         if kinematics_tasks.ik_inline(arm, count, only_approach):

@@ -144,7 +144,9 @@ def ik_single_answer(
     robot: str, T: np.ndarray, reference: np.ndarray | None, select: str, approach_only: bool
 ) -> wire.Encoded:
     """IK of one pose (4, 4) [m] of built-in ``robot`` as JSON: every branch, the selected one
-    and its tool position residual, in [m]."""
+    and its tool position residual, in [m]; whether the target is reached, the nearest
+    solution's distance [m] and the solver (a Robot answers an unreachable target with its
+    nearest solution)."""
     result, residual = ik_single(get_robot(robot), T, reference, select, approach_only)
     selected = result.selected
     content = {
@@ -153,6 +155,9 @@ def ik_single_answer(
         "branch": None if selected is None else result.solutions[selected].branch,
         "orientation_residual": result.orientation_residual,
         "position_residual": residual,
+        "reachable": result.reachable,
+        "distance": result.distance,
+        "solver": result.solver,
         "solutions": [s._asdict() for s in result.solutions],
     }
     return wire.dumps(content), "application/json", {}

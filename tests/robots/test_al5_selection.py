@@ -24,7 +24,9 @@ def test_the_al5_robot_selects_the_branch_of_the_report_rule_as_lynxplan_arm() -
     """400 poses: FK of random configurations over twice the joint ranges (many branches
     outside the limits, some poses with none within them), a third moved off the reachable
     orientations; the same branch selected (or none) by the Robot and by ``lynxplan.arm``, and
-    the selected branch obeys the rule (q2 >= 0, q3 <= 0, within the limits)."""
+    the selected branch obeys the rule (q2 >= 0, q3 <= 0, within the limits). Away from the
+    limits: within the snap tolerance of one, a Robot keeps only branches that still reach the
+    pose after the snap (the AL5's package keeps the snapped branch)."""
     arm, robot = load_arm(), load_robot("al5")
     assert robot.selection_rules == ("nearest", "report")
     rng = np.random.default_rng(17)
@@ -54,6 +56,32 @@ def test_the_al5_robot_selects_the_branch_of_the_report_rule_as_lynxplan_arm() -
             for s in mine.solutions[: mine.selected]
         )
     assert compared >= 300 and 0 < none < compared
+
+
+def test_the_report_rule_takes_the_first_qualifying_branch_that_reaches() -> None:
+    """The rule on constructed branches (the AL5's own limits never leave two to choose from:
+    at most one branch of a pose is within them): the first branch within the limits that
+    reaches the target with q2 >= 0 and q3 <= 0, in slot order, not the nearest."""
+    from lynxplan.branches import IkResult, IkSolution
+    from lynxplan.robots.selection import by_report_rule
+
+    def branch(name: str, q2: float, q3: float, within: bool, miss: float) -> IkSolution:
+        error = 0.01 * (ord(name) - ord("a") + 1)  # a: 0.01 rad ... f: 0.06 rad
+        return IkSolution(np.array([0.1, q2, q3, 0.2, 0.0]), name, within, miss, error)
+
+    solutions = (
+        branch("a", 0.5, -0.5, False, 0.0),  # outside the limits
+        branch("b", -0.1, -0.5, True, 0.0),  # q2 < 0
+        branch("c", 0.5, 0.2, True, 0.0),  # q3 > 0
+        branch("d", 0.7, -0.5, True, 1e-3),  # misses the target
+        branch("e", 0.6, -0.4, True, 0.0),  # the report's
+        branch("f", 0.4, -0.3, True, 0.0),
+    )
+    nearest = IkResult(solutions, 5, True, 0.0, 0.004, "test")
+    chosen = by_report_rule(nearest)
+    assert (chosen.selected, chosen.orientation_residual) == (4, 0.05)
+    none = by_report_rule(IkResult(solutions[:4], 1, True, 0.0, 0.0, "test"))
+    assert none.selected is None and none.orientation_residual == 0.01  # the best branch's
 
 
 def test_nearest_stays_the_default_and_other_robots_offer_only_nearest() -> None:

@@ -24,6 +24,7 @@ from lynxplan.collision import (
     clearance_profile,
 )
 from lynxplan.constants import COAL_GJK_TOLERANCE
+from lynxplan.robots import load_robot
 from lynxplan.trajectory import MotionLimits, free_segment, ruckig_profile, toppra_profile
 from lynxplan.trajectory.retime import lspb_profile
 
@@ -117,8 +118,23 @@ def test_ik_single_equals_library(client: Client, http: httpx.Client) -> None:
             assert (a.branch, a.within_limits) == (b.branch, b.within_limits)
             assert a.position_error == pytest.approx(b.position_error, abs=KERNEL_ATOL)
             assert a.orientation_error == pytest.approx(b.orientation_error, abs=KERNEL_ATOL)
+        assert type(remote) is type(local)  # one result type (lynxplan.branches.IkResult)
+        assert (remote.reachable, remote.solver) == (True, "AL5 closed form")
+        assert remote.distance == pytest.approx(local.distance, abs=KERNEL_ATOL)
     answer = http.post("/ik", json={"T": arm.fk(q).tolist()}).json()
     assert answer["position_residual"] < 1e-12 and answer["branch"]
+
+
+def test_ik_single_of_a_robot_says_when_the_target_is_out_of_reach(client: Client) -> None:
+    """A Robot answers an unreachable target with its nearest solution: the answer says so
+    (``reachable``, ``distance``), as the library's result."""
+    so101 = load_robot("so101")
+    T = so101.fk(np.radians([10.0, -20.0, 30.0, 40.0, 5.0]))
+    T[:3, 3] *= 3.0
+    remote, local = client.ik(T, robot="so101"), so101.ik(T)
+    assert not remote.reachable and not local.reachable
+    assert remote.distance == pytest.approx(local.distance, rel=1e-12) and remote.distance > 0.1
+    assert remote.solver == local.solver and remote.selected == local.selected
 
 
 def test_ik_batch_json_and_binary_equal_library(client: Client, http: httpx.Client) -> None:
@@ -183,6 +199,11 @@ def test_ik_position_and_approach_target(http: httpx.Client) -> None:
         (b'{"T": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, "1"]]}', "T"),
         (b'{"T": [[1, 0, 0, 1e999], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]}', "body"),
         (b'{"T": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]], "select": 3}', "select"),
+        (
+            b'{"robot": "so101", "T": [[1, 0, 0, 0.2], [0, 1, 0, 0], [0, 0, 1, 0.1], [0, 0, 0, 1]],'
+            b' "select": "report"}',  # the AL5's rule
+            "select",
+        ),
         (b'{"position": [0.2, 0, 0.1], "approach": [0, 0, 0]}', "approach"),
         (b'{"q_reference": [0, 0]}', "T"),
     ],

@@ -99,7 +99,7 @@ def across_yaw_axis(prm: np.ndarray, d0: float, d1: float, d2: float) -> tuple[f
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def lateral_offset(prm: np.ndarray, theta: float) -> float:
+def tool_lateral(prm: np.ndarray, theta: float) -> float:
     """The tool point's offset along the pitch axis from the yaw axis at roll theta [m]: the
     distance from the yaw axis the yaw must give the target."""
     lat: float = (
@@ -117,7 +117,7 @@ def yaw(
 ) -> tuple[float, float]:
     """Canonical yaw angle phi of one side for roll theta, and the lateral miss [m]."""
     dp, dh, rho = across_yaw_axis(prm, d0, d1, d2)
-    lat = lateral_offset(prm, theta)
+    lat = tool_lateral(prm, theta)
     # on the yaw axis: any yaw; keep the reference
     if rho <= ROLL_DEGENERATE and abs(lat) <= ROLL_DEGENERATE:
         return phi_ref + side * math.pi, 0.0

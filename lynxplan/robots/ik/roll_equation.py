@@ -24,8 +24,8 @@ from lynxplan.robots.ik.family_geometry import (
     across_yaw_axis,
     best_roll,
     from_yaw_axis,
-    lateral_offset,
     pitch_sum,
+    tool_lateral,
     yaw,
 )
 
@@ -167,7 +167,7 @@ def lateral_miss(problem: RollProblem, theta: float) -> float:
     rho = across_yaw_axis(prm, d0, d1, d2)[2]
     if rho <= ROLL_DEGENERATE:
         return yaw(prm, d0, d1, d2, theta, side, phi_ref)[1]
-    lat = lateral_offset(prm, theta)
+    lat = tool_lateral(prm, theta)
     if lat > rho:
         return lat - rho
     if -lat > rho:
