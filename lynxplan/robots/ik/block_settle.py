@@ -40,7 +40,7 @@ from lynxplan.robots.ik.block_newton import (
     pose_rotation_angle,
     turn,
 )
-from lynxplan.robots.ik.family_geometry import wrap_into_limits
+from lynxplan.robots.ik.family_geometry import snaps, wrap_into_limits
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)
@@ -56,6 +56,22 @@ def wrapped(pr: Floats, q: Floats) -> Floats:
     q3, in3 = wrap_into_limits(q[3], lo[3], hi[3], tol)
     q4, in4 = wrap_into_limits(q[4], lo[4], hi[4], tol)
     return q0, q1, q2, q3, q4, 1.0 if in0 & in1 & in2 & in3 & in4 else 0.0
+
+
+@numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)
+def snaps_tuple(pr: Floats, q: Floats) -> bool:
+    """Whether wrapping q (5) into the limits moves an angle onto a limit (``snaps``): such a
+    candidate that is not taken goes to the scalar polish, which keeps it outside the limits
+    where the snap moves the tool off the pose (``family_polish.settle_pose``)."""
+    tol = pr[F.LIMIT_TOL]
+    moved: bool = (
+        snaps(q[0], pr[F.LOWER], pr[F.UPPER], tol)
+        | snaps(q[1], pr[F.LOWER + 1], pr[F.UPPER + 1], tol)
+        | snaps(q[2], pr[F.LOWER + 2], pr[F.UPPER + 2], tol)
+        | snaps(q[3], pr[F.LOWER + 3], pr[F.UPPER + 3], tol)
+        | snaps(q[4], pr[F.LOWER + 4], pr[F.UPPER + 4], tol)
+    )
+    return moved
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)
@@ -89,7 +105,9 @@ def settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     wide_vectors()
     for i in range(m):
         t = column_of(c, CANDIDATE_WIDTH, 0, i)
-        q0, q1, q2, q3, q4, inside = wrapped(pr, angles_of(c, i))
+        raw = angles_of(c, i)
+        moved = snaps_tuple(pr, raw)
+        q0, q1, q2, q3, q4, inside = wrapped(pr, raw)
         p = chain_pose(ch, q0, q1, q2, q3, q4)
         prev, fold = (
             c[CANDIDATE.previous_error * CANDIDATE_WIDTH + i],
@@ -98,7 +116,8 @@ def settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
         err, angle, good, far = verdict(t, p, prev, fold)
         put_angles(c, i, q0, q1, q2, q3, q4)
         c[CANDIDATE.taken * CANDIDATE_WIDTH + i] = good
-        c[CANDIDATE.fallback * CANDIDATE_WIDTH + i] = 1.0 if (good == 0.0) & (far == 0.0) else 0.0
+        fall = (good == 0.0) & ((far == 0.0) | moved)
+        c[CANDIDATE.fallback * CANDIDATE_WIDTH + i] = 1.0 if fall else 0.0
         c[CANDIDATE.within * CANDIDATE_WIDTH + i] = inside
         c[CANDIDATE.position_error * CANDIDATE_WIDTH + i] = err
         c[CANDIDATE.orientation_error * CANDIDATE_WIDTH + i] = angle
@@ -147,6 +166,7 @@ def polish_settle_all_of(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel
         )
         q, sn, cs, ratio, size, big = polish_twice(ch, t, angles_of(c, i), sines, cosines, parallel)
         w0, w1, w2, w3, w4, inside = wrapped(pr, q)
+        moved = snaps_tuple(pr, q)
         r0, r1, r2 = snapped(q[0], w0), snapped(q[1], w1), snapped(q[2], w2)
         r3, r4 = snapped(q[3], w3), snapped(q[4], w4)
         s0, c0 = turn(sn[0], cs[0], r0)
@@ -162,7 +182,7 @@ def polish_settle_all_of(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel
         put_angles(c, i, w0, w1, w2, w3, w4)
         c[CANDIDATE.previous_error * CANDIDATE_WIDTH + i] = size
         c[CANDIDATE.taken * CANDIDATE_WIDTH + i] = good
-        fall = (ratio < BLOCK_ILL_CONDITIONED) | ((good == 0.0) & (far == 0.0))
+        fall = (ratio < BLOCK_ILL_CONDITIONED) | ((good == 0.0) & ((far == 0.0) | moved))
         c[CANDIDATE.fallback * CANDIDATE_WIDTH + i] = 1.0 if fall else 0.0
         c[CANDIDATE.within * CANDIDATE_WIDTH + i] = inside
         c[CANDIDATE.position_error * CANDIDATE_WIDTH + i] = err

@@ -34,7 +34,7 @@ from lynxplan.robots.ik.family_polish import (
     copy5,
     is_duplicate,
     polish,
-    settle,
+    settle_reaching,
 )
 from lynxplan.robots.ik.roll_equation import SCRATCH_ROWS, prepare_roll_terms
 from lynxplan.robots.ik.roll_search import (
@@ -295,7 +295,7 @@ def _family_ik(  # noqa: PLR0912, PLR0915 (numba kernel: one compiled loop per p
                         ):
                             rg = q[4]
                         polish(chain_problem, rg, q, scratch, scratch4, scratch5)
-                    inside, err = settle(prm, placements, axes, target, q, pose, work)
+                    inside, err = settle_reaching(prm, placements, axes, target, q, pose, work)
                     # the same branch reached twice (merged roots, a fold)
                     if is_duplicate(q_out[n], valid[n], b, q, BRANCH_DUPLICATE_TOLERANCE):
                         continue

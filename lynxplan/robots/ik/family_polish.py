@@ -12,7 +12,13 @@ import math
 import numba
 import numpy as np
 
-from lynxplan.constants import CHORD_RATE, POLISH_CONDITION_TOLERANCE, POLISH_FD_STEP
+from lynxplan.constants import (
+    CHORD_RATE,
+    POLISH_CONDITION_TOLERANCE,
+    POLISH_FD_STEP,
+    POSE_EXACT,
+    REACH_TOLERANCE,
+)
 from lynxplan.robots import family as F  # noqa: N812
 from lynxplan.robots.chain import chain_fk
 from lynxplan.robots.ik.family_geometry import (
@@ -21,6 +27,7 @@ from lynxplan.robots.ik.family_geometry import (
     MODE_POSE,
     ChainProblem,
     rotate,
+    snaps,
     wrap_into_limits,
 )
 
@@ -267,11 +274,84 @@ def settle(
         inside = inside and ok
     if not current:
         chain_fk(placements, axes, q, pose, work)
+    return inside, position_error(pose, target)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def position_error(pose: np.ndarray, target: np.ndarray) -> float:
+    """Distance between the tool points of two poses (4, 4) [m]."""
     err = 0.0
     for i in range(3):
         d = pose[i, 3] - target[i, 3]
         err += d * d
-    return inside, math.sqrt(err)
+    return math.sqrt(err)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def snaps_any(prm: np.ndarray, q: np.ndarray) -> bool:
+    """Whether wrapping q (5,) into the limits of prm moves an angle onto a limit (``snaps``)."""
+    lo, hi, tol = prm[F.LOWER :], prm[F.UPPER :], prm[F.LIMIT_TOL]
+    moved = False
+    for j in range(5):
+        moved = moved or snaps(q[j], lo[j], hi[j], tol)
+    return moved
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def unsnap(prm: np.ndarray, raw: tuple[float, float, float, float, float], q: np.ndarray) -> None:
+    """q (5,) = the angles raw moved into the limits by whole turns only (no snap)."""
+    for j in range(5):
+        q[j] = wrap_into_limits(raw[j], prm[F.LOWER + j], prm[F.UPPER + j], 0.0)[0]
+
+
+@numba.njit(cache=True, nogil=True)
+def settle_reaching(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+) -> tuple[bool, float]:
+    """``settle``, except where snapping an angle onto its limit moves the tool point off the
+    target (beyond REACH_TOLERANCE): the branch is then kept as it is, outside the limits
+    (whole turns only). A snap never turns a branch that reaches into one that misses."""
+    moved = snaps_any(prm, q)
+    raw = (q[0], q[1], q[2], q[3], q[4])
+    inside, err = settle(prm, placements, axes, target, q, pose, work)
+    if moved and err > REACH_TOLERANCE:
+        unsnap(prm, raw, q)
+        chain_fk(placements, axes, q, pose, work)
+        inside, err = False, position_error(pose, target)
+    return inside, err
+
+
+@numba.njit(cache=True, nogil=True)
+def settle_pose(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+    current: bool,
+) -> tuple[bool, float, float]:
+    """``settle`` for a full pose: (within the limits, position error [m], orientation error
+    [rad]). Where snapping an angle onto its limit moves the tool off the pose (beyond
+    POSE_EXACT), the branch is kept as it is, outside the limits (whole turns only): a snap
+    never turns an exact branch into none."""
+    moved = snaps_any(prm, q)
+    raw = (q[0], q[1], q[2], q[3], q[4])
+    inside, err = settle(prm, placements, axes, target, q, pose, work, current)
+    angle = rotation_angle(target, pose)
+    if moved and not (err <= POSE_EXACT and angle <= POSE_EXACT):
+        unsnap(prm, raw, q)
+        chain_fk(placements, axes, q, pose, work)
+        inside, err = False, position_error(pose, target)
+        angle = rotation_angle(target, pose)
+    return inside, err, angle
 
 
 @numba.njit(cache=True, nogil=True)

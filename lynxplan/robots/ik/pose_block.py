@@ -67,7 +67,7 @@ from lynxplan.robots.ik.block_layout import (
 )
 from lynxplan.robots.ik.block_newton import parallel_pitches
 from lynxplan.robots.ik.block_settle import polish_settle, repolish, settle_all
-from lynxplan.robots.ik.family_polish import is_duplicate, rotation_angle, settle
+from lynxplan.robots.ik.family_polish import is_duplicate, settle_pose
 from lynxplan.robots.ik.pose_kernel import (
     SLOT_COLUMNS,
     new_pose_scratch,
@@ -361,10 +361,9 @@ def blocks(  # noqa: PLR0912, PLR0915 (numba: one compiled pass)
                     current = False
                     if not exact:
                         current = polish_pose(placements, axes, targets[n], qs, scratch)
-                    inside, err = settle(
+                    inside, err, angle = settle_pose(
                         prm, placements, axes, targets[n], qs, pose, scratch.work, current
                     )
-                    angle = rotation_angle(targets[n], pose)
                     if not (err <= POSE_EXACT and angle <= POSE_EXACT):
                         continue
                 else:

@@ -56,8 +56,7 @@ from lynxplan.robots.ik.family_polish import (
     is_duplicate,
     lu_factor,
     lu_solve,
-    rotation_angle,
-    settle,
+    settle_pose,
 )
 from lynxplan.robots.results import BranchSlots
 
@@ -292,8 +291,9 @@ def solve_target(  # noqa: PLR0912, PLR0915 (numba: one compiled pass over the c
                 current = False
                 if not exact_model:
                     current = polish_pose(placements, axes, target, q, scratch)
-                inside, err = settle(prm, placements, axes, target, q, pose, scratch.work, current)
-                angle = rotation_angle(target, pose)
+                inside, err, angle = settle_pose(
+                    prm, placements, axes, target, q, pose, scratch.work, current
+                )
                 if not (err <= POSE_EXACT and angle <= POSE_EXACT):
                     continue
                 if is_duplicate(out, out[:, VALID], nb, q, BRANCH_DUPLICATE_TOLERANCE):
