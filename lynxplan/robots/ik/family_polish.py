@@ -314,16 +314,23 @@ def settle_reaching(
     pose: np.ndarray,
     work: np.ndarray,
 ) -> tuple[bool, float]:
-    """``settle``, except where snapping an angle onto its limit moves the tool point off the
-    target (beyond REACH_TOLERANCE): the branch is then kept as it is, outside the limits
-    (whole turns only). A snap never turns a branch that reaches into one that misses."""
+    """``settle``, except where snapping an angle onto its limit moves the tool point off a
+    target the branch reaches (beyond REACH_TOLERANCE): the branch is then kept as it is,
+    outside the limits (whole turns only). A snap never turns a branch that reaches into one
+    that misses; a branch that misses anyway (out of reach) keeps its snap."""
     moved = snaps_any(prm, q)
     raw = (q[0], q[1], q[2], q[3], q[4])
     inside, err = settle(prm, placements, axes, target, q, pose, work)
     if moved and err > REACH_TOLERANCE:
+        held = (q[0], q[1], q[2], q[3], q[4])
         unsnap(prm, raw, q)
         chain_fk(placements, axes, q, pose, work)
-        inside, err = False, position_error(pose, target)
+        unsnapped = position_error(pose, target)
+        if unsnapped <= REACH_TOLERANCE:
+            return False, unsnapped
+        for j in range(5):
+            q[j] = held[j]
+        chain_fk(placements, axes, q, pose, work)
     return inside, err
 
 
