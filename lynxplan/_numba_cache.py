@@ -30,6 +30,16 @@ def cached(kernel: str) -> bool:
         return True
 
 
+def import_numba() -> None:
+    """Import what :func:`cached` reads of numba, in the calling thread. Call it before asking
+    :func:`cached` in another thread while this one may import numba too: numba's modules import
+    each other, and two threads importing them at once can leave one with a partially
+    initialised module (an ImportError; ``lynxplan serve``'s start failed so, once in CI)."""
+    import llvmlite.binding  # noqa: F401
+    import numba  # noqa: F401
+    from numba.core import caching, codegen, config  # noqa: F401
+
+
 def _cached(kernel: str) -> bool:
     import llvmlite.binding as llvm
     from numba.core import caching, codegen, config

@@ -139,7 +139,9 @@ def handle(args: argparse.Namespace) -> int:
     from threading import Thread
 
     from lynxplan._jit import announce_if_cold
+    from lynxplan._numba_cache import import_numba
 
+    import_numba()  # here, not in both threads at once (the app's start imports numba too)
     Thread(target=announce_if_cold, args=(_log_line,), daemon=True).start()
     uvicorn.run(
         create_app(config),
