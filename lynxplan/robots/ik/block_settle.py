@@ -40,7 +40,7 @@ from lynxplan.robots.ik.block_newton import (
     pose_rotation_angle,
     turn,
 )
-from lynxplan.robots.ik.family_geometry import snaps, wrap_into_limits
+from lynxplan.robots.ik.family_geometry import wrap_into_limits
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)
@@ -59,17 +59,19 @@ def wrapped(pr: Floats, q: Floats) -> Floats:
 
 
 @numba.njit(cache=True, nogil=True, inline="always", fastmath=FAST)
-def snaps_tuple(pr: Floats, q: Floats) -> bool:
-    """Whether wrapping q (5) into the limits moves an angle onto a limit (``snaps``): such a
-    candidate that is not taken goes to the scalar polish, which keeps it outside the limits
-    where the snap moves the tool off the pose (``family_polish.settle_pose``)."""
-    tol = pr[F.LIMIT_TOL]
+def snapped_any(pr: Floats, q: Floats, w: Floats) -> bool:
+    """Whether the wrapped angles w (``wrapped``'s, 5) of q (5) moved an angle onto a limit:
+    more than whole turns (``wrap_into_limits`` without a tolerance). Such a candidate that is
+    not taken goes to the scalar polish, which keeps it outside the limits where the snap
+    moves the tool off the pose (``family_polish.settle_pose``)."""
+    lo = (pr[F.LOWER], pr[F.LOWER + 1], pr[F.LOWER + 2], pr[F.LOWER + 3], pr[F.LOWER + 4])
+    hi = (pr[F.UPPER], pr[F.UPPER + 1], pr[F.UPPER + 2], pr[F.UPPER + 3], pr[F.UPPER + 4])
     moved: bool = (
-        snaps(q[0], pr[F.LOWER], pr[F.UPPER], tol)
-        | snaps(q[1], pr[F.LOWER + 1], pr[F.UPPER + 1], tol)
-        | snaps(q[2], pr[F.LOWER + 2], pr[F.UPPER + 2], tol)
-        | snaps(q[3], pr[F.LOWER + 3], pr[F.UPPER + 3], tol)
-        | snaps(q[4], pr[F.LOWER + 4], pr[F.UPPER + 4], tol)
+        (wrap_into_limits(q[0], lo[0], hi[0], 0.0)[0] != w[0])
+        | (wrap_into_limits(q[1], lo[1], hi[1], 0.0)[0] != w[1])
+        | (wrap_into_limits(q[2], lo[2], hi[2], 0.0)[0] != w[2])
+        | (wrap_into_limits(q[3], lo[3], hi[3], 0.0)[0] != w[3])
+        | (wrap_into_limits(q[4], lo[4], hi[4], 0.0)[0] != w[4])
     )
     return moved
 
@@ -106,8 +108,8 @@ def settle_all(m: int, pr: Floats, ch: Floats, c: np.ndarray) -> None:
     for i in range(m):
         t = column_of(c, CANDIDATE_WIDTH, 0, i)
         raw = angles_of(c, i)
-        moved = snaps_tuple(pr, raw)
         q0, q1, q2, q3, q4, inside = wrapped(pr, raw)
+        moved = snapped_any(pr, raw, (q0, q1, q2, q3, q4))
         p = chain_pose(ch, q0, q1, q2, q3, q4)
         prev, fold = (
             c[CANDIDATE.previous_error * CANDIDATE_WIDTH + i],
@@ -166,7 +168,7 @@ def polish_settle_all_of(m: int, pr: Floats, ch: Floats, c: np.ndarray, parallel
         )
         q, sn, cs, ratio, size, big = polish_twice(ch, t, angles_of(c, i), sines, cosines, parallel)
         w0, w1, w2, w3, w4, inside = wrapped(pr, q)
-        moved = snaps_tuple(pr, q)
+        moved = snapped_any(pr, q, (w0, w1, w2, w3, w4))
         r0, r1, r2 = snapped(q[0], w0), snapped(q[1], w1), snapped(q[2], w2)
         r3, r4 = snapped(q[3], w3), snapped(q[4], w4)
         s0, c0 = turn(sn[0], cs[0], r0)

@@ -84,15 +84,6 @@ def wrap_into_limits(x: float, lo: float, hi: float, tol: float) -> tuple[float,
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
-def snaps(x: float, lo: float, hi: float, tol: float) -> bool:
-    """Whether ``wrap_into_limits`` moves angle x [rad] onto a limit (more than whole turns)."""
-    y = x - math.floor((x - lo) / TWO_PI) * TWO_PI
-    outside = ((x < lo) | (x > hi)) & (y > hi)
-    moved: bool = outside & ((y <= hi + tol) | (y >= lo + TWO_PI - tol))
-    return moved
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
 def from_yaw_axis(prm: np.ndarray, target: np.ndarray) -> tuple[float, float, float]:
     """The target's (4, 4) tool point from the yaw axis's point C1 (3) [m]."""
     return target[0, 3] - prm[F.C1], target[1, 3] - prm[F.C1 + 1], target[2, 3] - prm[F.C1 + 2]

@@ -27,7 +27,6 @@ from lynxplan.robots.ik.family_geometry import (
     MODE_POSE,
     ChainProblem,
     rotate,
-    snaps,
     wrap_into_limits,
 )
 
@@ -287,21 +286,38 @@ def position_error(pose: np.ndarray, target: np.ndarray) -> float:
     return math.sqrt(err)
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def snaps_any(prm: np.ndarray, q: np.ndarray) -> bool:
-    """Whether wrapping q (5,) into the limits of prm moves an angle onto a limit (``snaps``)."""
-    lo, hi, tol = prm[F.LOWER :], prm[F.UPPER :], prm[F.LIMIT_TOL]
+@numba.njit(cache=True, nogil=True)
+def unsnapped(
+    prm: np.ndarray,
+    placements: np.ndarray,
+    axes: np.ndarray,
+    target: np.ndarray,
+    raw: tuple[float, float, float, float, float],
+    q: np.ndarray,
+    pose: np.ndarray,
+    work: np.ndarray,
+) -> float:
+    """Where ``settle`` snapped an angle of raw (the 5 angles before it) onto a limit: q (5,) =
+    raw moved into the limits by whole turns only (``wrap_into_limits`` without a tolerance),
+    its pose on the exact chain into pose (4, 4) and its position error against target [m].
+    inf, q and pose untouched, where nothing snapped (q holds the same angles)."""
+    lo, hi = prm[F.LOWER :], prm[F.UPPER :]
+    free = (
+        wrap_into_limits(raw[0], lo[0], hi[0], 0.0)[0],
+        wrap_into_limits(raw[1], lo[1], hi[1], 0.0)[0],
+        wrap_into_limits(raw[2], lo[2], hi[2], 0.0)[0],
+        wrap_into_limits(raw[3], lo[3], hi[3], 0.0)[0],
+        wrap_into_limits(raw[4], lo[4], hi[4], 0.0)[0],
+    )
     moved = False
     for j in range(5):
-        moved = moved or snaps(q[j], lo[j], hi[j], tol)
-    return moved
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def unsnap(prm: np.ndarray, raw: tuple[float, float, float, float, float], q: np.ndarray) -> None:
-    """q (5,) = the angles raw moved into the limits by whole turns only (no snap)."""
+        moved = moved or free[j] != q[j]
+    if not moved:
+        return np.inf
     for j in range(5):
-        q[j] = wrap_into_limits(raw[j], prm[F.LOWER + j], prm[F.UPPER + j], 0.0)[0]
+        q[j] = free[j]
+    chain_fk(placements, axes, q, pose, work)
+    return position_error(pose, target)
 
 
 @numba.njit(cache=True, nogil=True)
@@ -318,19 +334,17 @@ def settle_reaching(
     target the branch reaches (beyond REACH_TOLERANCE): the branch is then kept as it is,
     outside the limits (whole turns only). A snap never turns a branch that reaches into one
     that misses; a branch that misses anyway (out of reach) keeps its snap."""
-    moved = snaps_any(prm, q)
     raw = (q[0], q[1], q[2], q[3], q[4])
     inside, err = settle(prm, placements, axes, target, q, pose, work)
-    if moved and err > REACH_TOLERANCE:
+    if err > REACH_TOLERANCE:
         held = (q[0], q[1], q[2], q[3], q[4])
-        unsnap(prm, raw, q)
-        chain_fk(placements, axes, q, pose, work)
-        unsnapped = position_error(pose, target)
-        if unsnapped <= REACH_TOLERANCE:
-            return False, unsnapped
-        for j in range(5):
-            q[j] = held[j]
-        chain_fk(placements, axes, q, pose, work)
+        free = unsnapped(prm, placements, axes, target, raw, q, pose, work)
+        if free <= REACH_TOLERANCE:
+            return False, free
+        if free < np.inf:  # the snapped branch after all
+            for j in range(5):
+                q[j] = held[j]
+            chain_fk(placements, axes, q, pose, work)
     return inside, err
 
 
@@ -349,15 +363,13 @@ def settle_pose(
     [rad]). Where snapping an angle onto its limit moves the tool off the pose (beyond
     POSE_EXACT), the branch is kept as it is, outside the limits (whole turns only): a snap
     never turns an exact branch into none."""
-    moved = snaps_any(prm, q)
     raw = (q[0], q[1], q[2], q[3], q[4])
     inside, err = settle(prm, placements, axes, target, q, pose, work, current)
     angle = rotation_angle(target, pose)
-    if moved and not (err <= POSE_EXACT and angle <= POSE_EXACT):
-        unsnap(prm, raw, q)
-        chain_fk(placements, axes, q, pose, work)
-        inside, err = False, position_error(pose, target)
-        angle = rotation_angle(target, pose)
+    if not (err <= POSE_EXACT and angle <= POSE_EXACT):
+        free = unsnapped(prm, placements, axes, target, raw, q, pose, work)
+        if free < np.inf:
+            inside, err, angle = False, free, rotation_angle(target, pose)
     return inside, err, angle
 
 
